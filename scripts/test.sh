@@ -1,0 +1,41 @@
+#!/usr/bin/env bash
+# The project's one test command (README; .ci/run calls exactly this). On a fresh Debian machine
+# with only rustup it installs what it needs (scripts/setup.sh), then runs: formatting, clippy
+# for both targets, native tests on the Vulkan backend (lavapipe when no GPU), the wasm build,
+# the wasm-bindgen browser tests and the page's end-to-end test in headless Chromium (WebGPU).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+step() { printf '\n==> %s\n' "$*"; }
+
+step "setup"
+scripts/setup.sh
+
+# wgpu silently falls back to GL without this when no Vulkan driver is found.
+export WGPU_BACKEND=${WGPU_BACKEND:-vulkan}
+# Silences harmless lavapipe warnings about a missing runtime dir.
+export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/artmesh-xdg-$(id -u)}
+mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
+
+step "format"
+cargo fmt --check
+
+step "clippy (native and wasm32)"
+cargo clippy --all-targets -q -- -D warnings
+cargo clippy --lib --tests --target wasm32-unknown-unknown -q -- -D warnings
+
+step "native tests (WGPU_BACKEND=$WGPU_BACKEND)"
+cargo test --all-targets
+
+step "wasm build of the page"
+web/build.sh
+
+step "browser tests (wasm-bindgen-test in headless Chromium, WebGPU)"
+export CHROMEDRIVER=${CHROMEDRIVER:-/usr/bin/chromedriver}
+export WASM_BINDGEN_TEST_TIMEOUT=${WASM_BINDGEN_TEST_TIMEOUT:-900}
+cargo test --target wasm32-unknown-unknown --test web
+
+step "page end-to-end test (playwright-core + Debian Chromium)"
+(cd web && { [ -d node_modules/playwright-core ] || npm ci --no-audit --no-fund --loglevel=error; } && node test/page.mjs)
+
+step "all tests passed"

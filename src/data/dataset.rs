@@ -1,0 +1,649 @@
+//! The dataset: reading and validating a [`FileSet`], and writing one back in the same layout.
+
+use std::collections::BTreeSet;
+
+use super::camera::Camera;
+use super::error::{DataError, DatasetErrors, Errors};
+use super::gt::{self, GtJoint, GtMeshes};
+use super::image_io::{self, DepthMap, PartMap, RgbaImage};
+use super::npy;
+use super::paths;
+use super::ply::{PlyFormat, TriMesh};
+use super::transforms::{self, FrameSpec};
+use super::{FileSet, GT_TRANS_PATH, Split, State, transforms_file_name};
+
+/// One view: camera, colour, and optional depth and part ids, all of the same size.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Frame {
+    /// File stem of the colour image, e.g. `"0000"`; names the frame's files when written.
+    pub name: String,
+    /// Pose and intrinsics.
+    pub camera: Camera,
+    /// Articulation time: 0 = start, 1 = end.
+    pub time: f32,
+    /// Colour; alpha is the foreground mask.
+    pub rgba: RgbaImage,
+    /// Depth in millimetres, if the dataset has depth.
+    pub depth: Option<DepthMap>,
+    /// Part ids, if the dataset has semantic maps.
+    pub parts: Option<PartMap>,
+}
+
+/// The frames of one state and split.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ViewSet {
+    /// Articulation state.
+    pub state: State,
+    /// Train or test.
+    pub split: Split,
+    /// Frames in file order (never empty in a dataset read from files).
+    pub frames: Vec<Frame>,
+}
+
+/// A whole dataset: views of both states, part count, optional ground truth.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Dataset {
+    /// Present (state, split) combinations, in the order start/train, start/test, end/train, end/test.
+    pub views: Vec<ViewSet>,
+    /// Number of parts: the static base plus the movable parts. 1 + the number of joints when
+    /// `gt/trans.json` exists; otherwise 1 + the largest part id seen, or 1 + the number of movable GT
+    /// meshes if that is larger; at least 1.
+    pub num_parts: usize,
+    /// Ground-truth joints (one per movable part, in part order), from `gt/trans.json`.
+    pub gt_joints: Option<Vec<GtJoint>>,
+    /// Ground-truth meshes per state, indexed by [`State::index`].
+    pub gt_meshes: [Option<GtMeshes>; 2],
+}
+
+/// How [`Dataset::to_files_with`] writes semantic maps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SemanticFormat {
+    /// Our 16-bit PNG (0 = background, k+1 = part k).
+    #[default]
+    Png,
+    /// GaussianArt-style `.npy` of `<i4` part ids (-1 = background).
+    Npy,
+}
+
+/// Options of the writer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct WriteOptions {
+    /// Semantic map encoding.
+    pub semantic: SemanticFormat,
+}
+
+/// Part count implied by the ground-truth joints, the largest part id seen and the GT mesh count: one rule for
+/// reader and writer. With `gt/trans.json` it is 1 + joints; otherwise 1 + the largest id or mesh index.
+fn implied_num_parts(
+    joints: Option<&[GtJoint]>,
+    max_id: Option<i16>,
+    max_movable_meshes: usize,
+) -> usize {
+    match joints {
+        Some(j) => 1 + j.len(),
+        None => {
+            let from_ids = max_id.map_or(0, |m| usize::try_from(i32::from(m) + 1).unwrap_or(0));
+            from_ids.max(1 + max_movable_meshes)
+        }
+    }
+}
+
+/// Frames of one split seen so far, for checks across frames.
+#[derive(Default)]
+struct SplitChecks {
+    /// Size of the first readable image and its path.
+    reference: Option<(u32, u32, String)>,
+    /// Per kind (depth, semantic): paths found, and expected paths that were missing.
+    present: [Vec<String>; 2],
+    missing: [Vec<String>; 2],
+}
+
+impl Dataset {
+    /// Reads and validates a dataset, reporting every problem found (not just the first).
+    ///
+    /// Checks: train transforms of both states present (test optional); JSON well-formed and typed;
+    /// `frames` non-empty; every referenced image exists and decodes with the expected pixel format;
+    /// matrices finite and rigid (orthonormal rotation with det +1 within 1e-3, last row 0 0 0 1);
+    /// `time` finite; angles in (0, π); focal lengths positive; images of a split agree in size with each
+    /// other and with `w`/`h`; depth and semantic maps match their image's size and are present for all
+    /// frames of a split or none; part ids are -1..num_parts-1; GT meshes cover every movable part.
+    pub fn from_files(files: &FileSet) -> Result<Dataset, DatasetErrors> {
+        let mut errs = Errors::default();
+        let gt_joints = files
+            .get(GT_TRANS_PATH)
+            .and_then(|b| gt::parse_trans(b, &mut errs));
+        let part_limit = gt_joints.as_ref().map(|j| j.len() + 1);
+
+        let mut views = Vec::new();
+        for state in State::ALL {
+            for split in Split::ALL {
+                let file = transforms_file_name(split, state);
+                match files.get(&file) {
+                    Some(bytes) => {
+                        if let Some(v) = read_view_set(files, &file, bytes, state, split, part_limit, &mut errs) {
+                            views.push(v);
+                        }
+                    }
+                    None if split == Split::Train => errs.push(DataError::file(
+                        file,
+                        format!("missing: the train views of both states are required (found no {} state)", state.name()),
+                    )),
+                    None => {} // Test views are optional.
+                }
+            }
+        }
+
+        let meshes = State::ALL.map(|s| read_gt_meshes(files, s, &mut errs));
+        let max_id = views
+            .iter()
+            .flat_map(|v| &v.frames)
+            .filter_map(|f| f.parts.as_ref()?.max_id())
+            .max();
+        let max_meshes = meshes
+            .iter()
+            .flatten()
+            .map(|m| m.movable.len())
+            .max()
+            .unwrap_or(0);
+        let num_parts = implied_num_parts(gt_joints.as_deref(), max_id, max_meshes);
+        for (state, m) in State::ALL.iter().zip(&meshes) {
+            if let Some(m) = m {
+                check_mesh_count(
+                    *state,
+                    m.movable.len(),
+                    num_parts,
+                    gt_joints.is_some(),
+                    &mut errs,
+                );
+            }
+        }
+        errs.finish(Dataset {
+            views,
+            num_parts,
+            gt_joints,
+            gt_meshes: meshes,
+        })
+    }
+
+    /// Writes the dataset in the layout it is read from (PNG semantic maps).
+    pub fn to_files(&self) -> Result<FileSet, DataError> {
+        self.to_files_with(&WriteOptions::default())
+    }
+
+    /// Writes the dataset with the given options. Fails on data the reader would reject or that cannot be
+    /// encoded (empty view sets, mismatched sizes, duplicate frame names, inconsistent part count).
+    pub fn to_files_with(&self, options: &WriteOptions) -> Result<FileSet, DataError> {
+        let mut out = FileSet::new();
+        for state in State::ALL {
+            if self.views(state, Split::Train).is_none() {
+                return Err(DataError::file(
+                    transforms_file_name(Split::Train, state),
+                    "cannot write: the train views of both states are required",
+                ));
+            }
+        }
+        for view in &self.views {
+            let file = transforms_file_name(view.split, view.state);
+            if out.contains_key(&file) {
+                return Err(DataError::file(
+                    file,
+                    "cannot write: two view sets for the same state and split",
+                ));
+            }
+            write_view_set(view, options, &mut out)?;
+            out.insert(file, transforms::write(view));
+        }
+        let max_id = self
+            .views
+            .iter()
+            .flat_map(|v| &v.frames)
+            .filter_map(|f| f.parts.as_ref()?.max_id())
+            .max();
+        let max_meshes = self
+            .gt_meshes
+            .iter()
+            .flatten()
+            .map(|m| m.movable.len())
+            .max()
+            .unwrap_or(0);
+        let implied = implied_num_parts(self.gt_joints.as_deref(), max_id, max_meshes);
+        if implied != self.num_parts {
+            return Err(DataError::field(
+                GT_TRANS_PATH,
+                "num_parts",
+                format!(
+                    "cannot write: num_parts is {}, but the joints, part ids and GT meshes imply {implied}",
+                    self.num_parts
+                ),
+            ));
+        }
+        if let Some(joints) = &self.gt_joints {
+            out.insert(GT_TRANS_PATH.into(), gt::write_trans(joints));
+        }
+        for state in State::ALL {
+            if let Some(m) = &self.gt_meshes[state.index()] {
+                out.insert(
+                    gt::static_mesh_path(state),
+                    m.static_part.to_ply(PlyFormat::BinaryLittleEndian),
+                );
+                for (i, mesh) in m.movable.iter().enumerate() {
+                    out.insert(
+                        gt::movable_mesh_path(state, i),
+                        mesh.to_ply(PlyFormat::BinaryLittleEndian),
+                    );
+                }
+            }
+        }
+        Ok(out)
+    }
+
+    /// The views of one state and split, if the dataset has them.
+    pub fn views(&self, state: State, split: Split) -> Option<&ViewSet> {
+        self.views
+            .iter()
+            .find(|v| v.state == state && v.split == split)
+    }
+
+    /// Ground-truth meshes of one state, if present.
+    pub fn gt_meshes_for(&self, state: State) -> Option<&GtMeshes> {
+        self.gt_meshes[state.index()].as_ref()
+    }
+
+    /// Number of movable parts (`num_parts - 1`).
+    pub fn num_movable(&self) -> usize {
+        self.num_parts.saturating_sub(1)
+    }
+
+    /// All frames of all view sets.
+    pub fn frames(&self) -> impl Iterator<Item = &Frame> {
+        self.views.iter().flat_map(|v| &v.frames)
+    }
+}
+
+/// Reads one transforms file and the images it refers to.
+fn read_view_set(
+    files: &FileSet,
+    file: &str,
+    bytes: &[u8],
+    state: State,
+    split: Split,
+    part_limit: Option<usize>,
+    errs: &mut Errors,
+) -> Option<ViewSet> {
+    let spec = transforms::parse(file, bytes, errs)?;
+    let mut checks = SplitChecks::default();
+    let mut frames = Vec::with_capacity(spec.frames.len());
+    for fs in &spec.frames {
+        if let Some(frame) = read_frame(files, file, fs, state, part_limit, &mut checks, errs) {
+            frames.push(frame);
+        }
+    }
+    // Depth and semantic maps are optional per dataset, but all-or-nothing within a split.
+    for (k, kind) in ["depth maps", "semantic maps"].iter().enumerate() {
+        if let Some(example) = checks.present[k].first() {
+            for missing in &checks.missing[k] {
+                errs.push(DataError::file(
+                    missing.clone(),
+                    format!(
+                        "missing: other frames of {}/{} have {kind} (e.g. {example}), so every frame needs one",
+                        state.name(),
+                        split.name()
+                    ),
+                ));
+            }
+        }
+    }
+    (!frames.is_empty()).then_some(ViewSet {
+        state,
+        split,
+        frames,
+    })
+}
+
+fn size_error(file: &str, what: &str, w: u32, h: u32, found_w: u32, found_h: u32) -> DataError {
+    DataError::field(
+        file,
+        "size",
+        format!("expected {w}x{h} ({what}), found {found_w}x{found_h}"),
+    )
+}
+
+/// Finds and reads the optional depth or semantic file of a frame (`k`: 0 depth, 1 semantic).
+fn sibling_file<'a>(
+    files: &'a FileSet,
+    rgba_path: &str,
+    k: usize,
+    checks: &mut SplitChecks,
+) -> Option<(String, &'a [u8])> {
+    let (kind, exts): (&str, &[&str]) = if k == 0 {
+        ("depth", &[".png"])
+    } else {
+        ("semantic", &[".png", ".npy"])
+    };
+    let candidates: Vec<String> = exts
+        .iter()
+        .filter_map(|e| paths::sibling(rgba_path, kind, e))
+        .collect();
+    let found = candidates
+        .iter()
+        .find_map(|p| files.get(p).map(|b| (p.clone(), b.as_slice())));
+    match &found {
+        Some((p, _)) => checks.present[k].push(p.clone()),
+        None => checks.missing[k].push(
+            candidates
+                .into_iter()
+                .next()
+                .unwrap_or_else(|| rgba_path.to_string()),
+        ),
+    }
+    found
+}
+
+fn read_frame(
+    files: &FileSet,
+    file: &str,
+    fs: &FrameSpec,
+    state: State,
+    part_limit: Option<usize>,
+    checks: &mut SplitChecks,
+    errs: &mut Errors,
+) -> Option<Frame> {
+    let candidates = paths::image_candidates(&fs.file_path);
+    let Some((rgba_path, bytes)) = candidates
+        .iter()
+        .find_map(|p| files.get(p).map(|b| (p.clone(), b)))
+    else {
+        errs.push(DataError::field(
+            file,
+            format!("{}.file_path", fs.field),
+            format!(
+                "refers to {}, which is not in the dataset",
+                candidates.join(" or ")
+            ),
+        ));
+        return None;
+    };
+    let rgba = errs.keep(image_io::decode_rgba(&rgba_path, bytes));
+
+    // Size agreement: with w/h from the transforms file when given, else with the first image of the split.
+    if let Some(img) = &rgba {
+        let reference = checks
+            .reference
+            .get_or_insert_with(|| (img.width, img.height, rgba_path.clone()));
+        let (w, h) = (
+            fs.intrinsics.w.unwrap_or(reference.0),
+            fs.intrinsics.h.unwrap_or(reference.1),
+        );
+        if (img.width, img.height) != (w, h) {
+            let what = if fs.intrinsics.w.is_some() || fs.intrinsics.h.is_some() {
+                format!("w/h in {file}")
+            } else {
+                format!("the size of {}, the first image of this split", reference.2)
+            };
+            errs.push(size_error(&rgba_path, &what, w, h, img.width, img.height));
+        }
+    }
+
+    let depth = sibling_file(files, &rgba_path, 0, checks).and_then(|(path, b)| {
+        let d = errs.keep(image_io::decode_depth(&path, b))?;
+        if let Some(img) = &rgba
+            && (d.width, d.height) != (img.width, img.height)
+        {
+            errs.push(size_error(
+                &path,
+                &format!("the size of {rgba_path}"),
+                img.width,
+                img.height,
+                d.width,
+                d.height,
+            ));
+        }
+        Some(d)
+    });
+
+    let parts = sibling_file(files, &rgba_path, 1, checks).and_then(|(path, b)| {
+        let m = if path.ends_with(".npy") {
+            errs.keep(npy::decode_parts_npy(&path, b))?
+        } else {
+            errs.keep(image_io::decode_parts_png(&path, b))?
+        };
+        if let Some(img) = &rgba
+            && (m.width, m.height) != (img.width, img.height)
+        {
+            errs.push(size_error(&path, &format!("the size of {rgba_path}"), img.width, img.height, m.width, m.height));
+        }
+        if let Some(limit) = part_limit
+            && let Some(i) = m.ids.iter().position(|&id| usize::try_from(id).is_ok_and(|id| id >= limit))
+        {
+            let w = m.width.max(1) as usize;
+            errs.push(DataError::field(
+                &path,
+                "part id",
+                format!(
+                    "part id {} at pixel ({}, {}) is out of range: expected -1 (background) to {} ({GT_TRANS_PATH} has {} joints, so {limit} parts)",
+                    m.ids[i],
+                    i % w,
+                    i / w,
+                    limit - 1,
+                    limit - 1
+                ),
+            ));
+        }
+        Some(m)
+    });
+
+    let rgba = rgba?;
+    let camera_to_world = fs.camera_to_world?;
+    let intrinsics = fs.intrinsics.resolve(rgba.width, rgba.height)?;
+    Some(Frame {
+        name: paths::frame_name(&rgba_path).to_string(),
+        camera: Camera {
+            camera_to_world,
+            intrinsics,
+        },
+        time: fs.time.unwrap_or(state.default_time()),
+        rgba,
+        depth,
+        parts,
+    })
+}
+
+/// Reads `gt/{state}/...ply`; `None` when the state has no GT mesh files.
+fn read_gt_meshes(files: &FileSet, state: State, errs: &mut Errors) -> Option<GtMeshes> {
+    let prefix = format!("gt/{0}/{0}_dynamic_", state.name());
+    let mut indexed: BTreeSet<usize> = BTreeSet::new();
+    for key in files
+        .range(prefix.clone()..)
+        .map(|(k, _)| k)
+        .take_while(|k| k.starts_with(&prefix))
+    {
+        if let Some(i) = key
+            .strip_prefix(&prefix)
+            .and_then(|r| r.strip_suffix("_rotate.ply"))
+            .and_then(|n| n.parse().ok())
+        {
+            indexed.insert(i);
+        }
+    }
+    let single = gt::single_movable_mesh_path(state);
+    let static_path = gt::static_mesh_path(state);
+    let mut movable_paths: Vec<String> = match indexed.last() {
+        Some(&last) => (0..=last)
+            .map(|i| gt::movable_mesh_path(state, i))
+            .collect(),
+        None if files.contains_key(&single) => vec![single],
+        None => Vec::new(),
+    };
+    if movable_paths.is_empty() && !files.contains_key(&static_path) {
+        return None;
+    }
+    let before = errs.len();
+    let read = |path: &str, errs: &mut Errors| match files.get(path) {
+        Some(b) => errs.keep(TriMesh::from_ply(path, b)),
+        None => {
+            errs.push(DataError::file(
+                path,
+                "missing: other ground-truth meshes of this state exist",
+            ));
+            None
+        }
+    };
+    let static_part = read(&static_path, errs);
+    let movable: Vec<TriMesh> = movable_paths
+        .drain(..)
+        .filter_map(|p| read(&p, errs))
+        .collect();
+    (errs.len() == before).then(|| GtMeshes {
+        static_part: static_part.unwrap_or_default(),
+        movable,
+    })
+}
+
+/// A state's GT meshes must cover every movable part, and no more.
+fn check_mesh_count(
+    state: State,
+    count: usize,
+    num_parts: usize,
+    from_joints: bool,
+    errs: &mut Errors,
+) {
+    let expected = num_parts.saturating_sub(1);
+    let why = if from_joints {
+        format!("{GT_TRANS_PATH} has {expected} joints")
+    } else {
+        format!("the part ids show {num_parts} parts")
+    };
+    for i in count..expected {
+        errs.push(DataError::file(
+            gt::movable_mesh_path(state, i),
+            format!("missing: {why}, so every movable part needs a mesh"),
+        ));
+    }
+    for i in expected..count {
+        errs.push(DataError::file(
+            gt::movable_mesh_path(state, i),
+            format!("unexpected: {why}, so there is no movable part {i}"),
+        ));
+    }
+}
+
+/// Checks a view set the writer is about to write, and encodes its images into `out`.
+fn write_view_set(
+    view: &ViewSet,
+    options: &WriteOptions,
+    out: &mut FileSet,
+) -> Result<(), DataError> {
+    let file = transforms_file_name(view.split, view.state);
+    let first = view.frames.first().ok_or_else(|| {
+        DataError::field(
+            &file,
+            "frames",
+            "cannot write an empty view set: expected at least one frame",
+        )
+    })?;
+    let mut names = BTreeSet::new();
+    for (i, frame) in view.frames.iter().enumerate() {
+        let field = format!("frames[{i}]");
+        let bad_name = frame.name.is_empty()
+            || frame.name.contains(['/', '\\'])
+            || frame.name == "."
+            || frame.name == ".."
+            || frame.name.to_ascii_lowercase().ends_with(".png");
+        if bad_name || !names.insert(frame.name.as_str()) {
+            return Err(DataError::field(
+                &file,
+                format!("{field}.name"),
+                format!(
+                    "cannot write: frame name \"{}\" is empty, a duplicate, or not a plain file stem",
+                    frame.name
+                ),
+            ));
+        }
+        let rgba_path = transforms::frame_path(view, "rgba", &frame.name, ".png");
+        let k = &frame.camera.intrinsics;
+        if (frame.rgba.width, frame.rgba.height) != (first.rgba.width, first.rgba.height)
+            || (k.width, k.height) != (frame.rgba.width, frame.rgba.height)
+        {
+            return Err(size_error(
+                &rgba_path,
+                "the first image and the intrinsics",
+                first.rgba.width,
+                first.rgba.height,
+                frame.rgba.width,
+                frame.rgba.height,
+            ));
+        }
+        if frame.depth.is_some() != first.depth.is_some()
+            || frame.parts.is_some() != first.parts.is_some()
+        {
+            return Err(DataError::field(
+                &file,
+                field,
+                "cannot write: depth and semantic maps must be present for all frames of a split or for none",
+            ));
+        }
+        out.insert(
+            rgba_path.clone(),
+            image_io::encode_png(
+                &rgba_path,
+                frame.rgba.width,
+                frame.rgba.height,
+                image_io::PngPixels::Rgba8(&frame.rgba.pixels),
+            )?,
+        );
+        if let Some(d) = &frame.depth {
+            let path = transforms::frame_path(view, "depth", &frame.name, ".png");
+            if (d.width, d.height) != (frame.rgba.width, frame.rgba.height) {
+                return Err(size_error(
+                    &path,
+                    &format!("the size of {rgba_path}"),
+                    frame.rgba.width,
+                    frame.rgba.height,
+                    d.width,
+                    d.height,
+                ));
+            }
+            let png = image_io::encode_png(
+                &path,
+                d.width,
+                d.height,
+                image_io::PngPixels::Gray16(&d.millimetres),
+            )?;
+            out.insert(path, png);
+        }
+        if let Some(m) = &frame.parts {
+            let ext = match options.semantic {
+                SemanticFormat::Png => ".png",
+                SemanticFormat::Npy => ".npy",
+            };
+            let path = transforms::frame_path(view, "semantic", &frame.name, ext);
+            if (m.width, m.height) != (frame.rgba.width, frame.rgba.height) {
+                return Err(size_error(
+                    &path,
+                    &format!("the size of {rgba_path}"),
+                    frame.rgba.width,
+                    frame.rgba.height,
+                    m.width,
+                    m.height,
+                ));
+            }
+            let expected_len = u64::from(m.width) * u64::from(m.height);
+            if m.ids.len() as u64 != expected_len || m.ids.iter().any(|&id| id < -1) {
+                return Err(DataError::field(
+                    &path,
+                    "part id",
+                    format!(
+                        "cannot write: expected {expected_len} ids of at least -1, found {} ids",
+                        m.ids.len()
+                    ),
+                ));
+            }
+            let bytes = match options.semantic {
+                SemanticFormat::Png => image_io::encode_parts_png(&path, m)?,
+                SemanticFormat::Npy => npy::encode_parts_npy(m),
+            };
+            out.insert(path, bytes);
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,118 @@
+//! Native-only bridge between a folder on disk and a [`FileSet`]. Never overwrites anything.
+
+use std::fs;
+use std::io::Write;
+use std::path::{Component, Path};
+
+use super::FileSet;
+use super::error::DataError;
+
+/// Folders nested deeper than this are not followed (guards against symlink loops).
+const MAX_DEPTH: usize = 32;
+
+/// Reads every non-hidden file below `root` into a [`FileSet`] keyed by `'/'`-separated relative path.
+/// Hidden files and folders (name starting with `.`) are skipped. Read-only.
+pub fn read_dir(root: &Path) -> Result<FileSet, DataError> {
+    let shown = root.display().to_string();
+    let meta = fs::metadata(root)
+        .map_err(|e| DataError::file(&shown, format!("cannot open the dataset folder: {e}")))?;
+    if !meta.is_dir() {
+        return Err(DataError::file(
+            &shown,
+            "expected a dataset folder, found a file",
+        ));
+    }
+    let mut files = FileSet::new();
+    walk(root, "", 0, &mut files)?;
+    Ok(files)
+}
+
+fn walk(dir: &Path, prefix: &str, depth: usize, files: &mut FileSet) -> Result<(), DataError> {
+    let shown = if prefix.is_empty() {
+        ".".to_string()
+    } else {
+        prefix.to_string()
+    };
+    if depth > MAX_DEPTH {
+        return Err(DataError::file(
+            shown,
+            format!("folders nested more than {MAX_DEPTH} deep (a symlink loop?)"),
+        ));
+    }
+    let entries = fs::read_dir(dir)
+        .map_err(|e| DataError::file(&shown, format!("cannot list folder: {e}")))?;
+    for entry in entries {
+        let entry =
+            entry.map_err(|e| DataError::file(&shown, format!("cannot list folder: {e}")))?;
+        let name = entry.file_name();
+        let Some(name) = name.to_str() else {
+            return Err(DataError::file(
+                &shown,
+                format!("file name {:?} is not valid UTF-8", entry.file_name()),
+            ));
+        };
+        if name.starts_with('.') {
+            continue;
+        }
+        let rel = if prefix.is_empty() {
+            name.to_string()
+        } else {
+            format!("{prefix}/{name}")
+        };
+        let path = entry.path();
+        // Follows symlinks, so linked folders and files are read like real ones.
+        let meta =
+            fs::metadata(&path).map_err(|e| DataError::file(&rel, format!("cannot read: {e}")))?;
+        if meta.is_dir() {
+            walk(&path, &rel, depth + 1, files)?;
+        } else if meta.is_file() {
+            let bytes =
+                fs::read(&path).map_err(|e| DataError::file(&rel, format!("cannot read: {e}")))?;
+            files.insert(rel, bytes);
+        }
+    }
+    Ok(())
+}
+
+/// Writes a [`FileSet`] below `root` (created if needed). Refuses to overwrite: if any file already exists,
+/// nothing is written and the error names it. Paths must be relative and stay inside `root`.
+pub fn write_dir(files: &FileSet, root: &Path) -> Result<(), DataError> {
+    for rel in files.keys() {
+        let ok = !rel.is_empty()
+            && Path::new(rel)
+                .components()
+                .all(|c| matches!(c, Component::Normal(_)))
+            && !rel.contains('\\');
+        if !ok {
+            return Err(DataError::file(
+                rel,
+                "expected a relative path inside the output folder",
+            ));
+        }
+        if root.join(rel).exists() {
+            return Err(DataError::file(
+                rel,
+                format!(
+                    "already exists in {}; refusing to overwrite",
+                    root.display()
+                ),
+            ));
+        }
+    }
+    for (rel, bytes) in files {
+        let path = root.join(rel);
+        if let Some(parent) = path.parent() {
+            fs::create_dir_all(parent)
+                .map_err(|e| DataError::file(rel, format!("cannot create folder: {e}")))?;
+        }
+        // `create_new` also refuses a file that appeared since the check above.
+        let mut f = fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .open(&path)
+            .map_err(|e| DataError::file(rel, format!("cannot create: {e}")))?;
+        f.write_all(bytes)
+            .map_err(|e| DataError::file(rel, format!("cannot write: {e}")))?;
+    }
+    Ok(())
+}

@@ -1,0 +1,134 @@
+//! Dataset layer: cameras, frames and the on-disk layout shared with ArtGS / GaussianArt (MPArt-90) / PARIS.
+//!
+//! Everything here works on bytes ([`FileSet`]: relative path → contents), so the same reader and writer run
+//! natively and in the browser. Only [`read_dir`] and [`write_dir`] touch the file system, and they are native-only.
+//! Bad input never panics: readers collect every problem they find as a [`DataError`] naming the file, the field
+//! and what was expected.
+//!
+//! Layout (paths relative to the dataset root; metres; z-up world):
+//! ```text
+//! transforms_{train,test}_{start,end}.json     cameras + frame list (train required for both states)
+//! {start,end}/{train,test}/rgba/0000.png       8-bit RGBA, alpha = foreground mask
+//! {start,end}/{train,test}/depth/0000.png      optional, 16-bit grey, millimetres, z-depth, 0 = invalid
+//! {start,end}/{train,test}/semantic/0000.png   optional, 16-bit grey, 0 = background, k+1 = part k (or .npy, -1 = background)
+//! gt/trans.json                                optional ground-truth joints
+//! gt/{state}/{state}_static_rotate.ply, gt/{state}/{state}_dynamic_{i}_rotate.ply   optional GT part meshes
+//! ```
+
+mod camera;
+mod dataset;
+mod error;
+pub mod fixture;
+#[cfg(not(target_arch = "wasm32"))]
+mod fs;
+mod gt;
+mod image_io;
+mod json;
+mod npy;
+mod paths;
+mod ply;
+mod summary;
+mod transforms;
+
+use std::collections::BTreeMap;
+
+pub use camera::{Camera, Intrinsics, look_at};
+pub use dataset::{Dataset, Frame, SemanticFormat, ViewSet, WriteOptions};
+pub use error::{DataError, DatasetErrors};
+#[cfg(not(target_arch = "wasm32"))]
+pub use fs::{read_dir, write_dir};
+pub use gt::{GtJoint, GtMeshes, JointKind};
+pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png};
+pub use npy::encode_npy;
+pub use paths::rebase_on_dataset_root;
+pub use ply::{PlyFormat, TriMesh};
+pub use summary::{Summary, ViewSummary};
+
+/// A dataset as bytes: relative path (`'/'` separators, e.g. `start/train/rgba/0000.png`) → file contents.
+pub type FileSet = BTreeMap<String, Vec<u8>>;
+
+/// Articulation state of the object.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum State {
+    /// First observed state (`time` 0).
+    Start,
+    /// Second observed state (`time` 1).
+    End,
+}
+
+impl State {
+    /// Both states, in file order.
+    pub const ALL: [State; 2] = [State::Start, State::End];
+
+    /// Name used in paths and file names: `"start"` / `"end"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            State::Start => "start",
+            State::End => "end",
+        }
+    }
+
+    /// 0 for start, 1 for end (index into per-state arrays).
+    pub fn index(self) -> usize {
+        match self {
+            State::Start => 0,
+            State::End => 1,
+        }
+    }
+
+    /// Default frame `time` for this state when the file gives none.
+    pub fn default_time(self) -> f32 {
+        match self {
+            State::Start => 0.0,
+            State::End => 1.0,
+        }
+    }
+}
+
+/// Train or test views.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "lowercase")]
+pub enum Split {
+    /// Views used for fitting (required for both states).
+    Train,
+    /// Held-out views (optional).
+    Test,
+}
+
+impl Split {
+    /// Both splits, in file order.
+    pub const ALL: [Split; 2] = [Split::Train, Split::Test];
+
+    /// Name used in paths and file names: `"train"` / `"test"`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Split::Train => "train",
+            Split::Test => "test",
+        }
+    }
+}
+
+impl std::fmt::Display for State {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl std::fmt::Display for Split {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Name of the transforms file for a split and state, e.g. `transforms_train_start.json`.
+pub fn transforms_file_name(split: Split, state: State) -> String {
+    format!("transforms_{}_{}.json", split.name(), state.name())
+}
+
+/// Path of the ground-truth joints file.
+pub const GT_TRANS_PATH: &str = "gt/trans.json";

@@ -1,0 +1,24 @@
+//! GPU foundation shared by every stage: one way to get a device natively and in the browser
+//! ([`GpuContext`]), buffer and readback helpers, the kernel-family wrapper that owns a shader's
+//! pipelines and bind-group layout, and the two data-parallel primitives later stages build on:
+//! an exclusive [`PrefixSum`] and a key–value [`RadixSort`] (the rasterizer's tile binning).
+//!
+//! Every kernel obeys the portability rules of DESIGN.md §3 so the same WGSL runs on lavapipe,
+//! on SwiftShader inside Chromium, and on real GPUs: ≤ 256 invocations per workgroup, ≤ 8 storage
+//! buffers per stage, no float atomics, dispatches tiled in 2-D past the per-dimension limit.
+
+mod buffers;
+mod context;
+mod kernel;
+mod radix_sort;
+mod scan;
+pub mod selftest;
+
+pub use buffers::binding_chunks;
+pub use context::{AdapterReport, GpuContext, GpuError};
+pub use kernel::{Binding, KernelFamily};
+pub use radix_sort::RadixSort;
+pub use scan::PrefixSum;
+
+/// Result type of everything that touches the GPU.
+pub type GpuResult<T> = Result<T, GpuError>;

@@ -1,0 +1,16 @@
+//! artmesh: articulated digital twins from multi-view RGB-D frames at two articulation states.
+//!
+//! The module tree follows the pipeline of the ArtMesh paper: [`data`] (cameras, frames, the dataset layout)
+//! feeds the fitting stages, which run as WGSL compute kernels through [`gpu`]. The crate is async and
+//! I/O-free at its core so the same code runs natively (CLI, tests, lavapipe in CI) and in the browser (WebGPU);
+//! file-system access lives only in the CLI and in native-only helpers.
+
+pub mod data;
+pub mod gpu;
+pub mod rng;
+
+#[cfg(not(target_arch = "wasm32"))]
+pub mod bench;
+
+#[cfg(target_arch = "wasm32")]
+pub mod web;
