@@ -9,24 +9,42 @@ fn linear_workgroup(id: vec3<u32>, count: vec3<u32>) -> u32 {
 }
 
 var<workgroup> wg_scan: array<u32, WG_SIZE>;
+// RAKE_LANES invocations each scan RAKE_LANES consecutive values (RAKE_LANES^2 = WG_SIZE).
+const RAKE_LANES: u32 = 16u;
+var<workgroup> wg_rake_offsets: array<u32, RAKE_LANES>;
+var<workgroup> wg_scan_total: u32;
 
-// Exclusive scan of one value per invocation across the workgroup (Hillis–Steele).
-// Returns (exclusive prefix, workgroup total). Call from uniform control flow only.
+// Exclusive scan of one value per invocation across the workgroup. Returns (exclusive prefix,
+// workgroup total). Call from uniform control flow only.
+//
+// Raking rather than Hillis–Steele: 4 barriers instead of 18. Barriers dominate on CPU
+// implementations (lavapipe, SwiftShader run a workgroup as SIMD chunks and switch between
+// them at every barrier), and the serial 16-element loops cost GPUs next to nothing.
 fn workgroup_exclusive_scan(lid: u32, value: u32) -> vec2<u32> {
     wg_scan[lid] = value;
     workgroupBarrier();
-    for (var offset = 1u; offset < WG_SIZE; offset = offset << 1u) {
-        var left = 0u;
-        if (lid >= offset) {
-            left = wg_scan[lid - offset];
+    if (lid < RAKE_LANES) {
+        var sum = 0u;
+        for (var i = 0u; i < RAKE_LANES; i++) {
+            let v = wg_scan[lid * RAKE_LANES + i];
+            wg_scan[lid * RAKE_LANES + i] = sum;
+            sum += v;
         }
-        workgroupBarrier();
-        wg_scan[lid] += left;
-        workgroupBarrier();
+        wg_rake_offsets[lid] = sum;
     }
-    let inclusive = wg_scan[lid];
-    let total = wg_scan[WG_SIZE - 1u];
-    // The buffer is reused by the next call: nobody may overwrite it before all have read.
     workgroupBarrier();
-    return vec2<u32>(inclusive - value, total);
+    if (lid == 0u) {
+        var sum = 0u;
+        for (var i = 0u; i < RAKE_LANES; i++) {
+            let v = wg_rake_offsets[i];
+            wg_rake_offsets[i] = sum;
+            sum += v;
+        }
+        wg_scan_total = sum;
+    }
+    workgroupBarrier();
+    let result = vec2<u32>(wg_scan[lid] + wg_rake_offsets[lid / RAKE_LANES], wg_scan_total);
+    // The buffers are reused by the next call: nobody may overwrite them before all have read.
+    workgroupBarrier();
+    return result;
 }

@@ -21,8 +21,12 @@ async function gpuSection() {
     return;
   }
   const adapter = JSON.parse(await adapter_report());
-  document.body.dataset.adapter = adapter.name;
-  show($("adapter"), `${adapter.name} (${adapter.backend}, ${adapter.device_type})\n` +
+  // The browser's own adapter info names the vendor and architecture even when it hides the description.
+  const info = (await navigator.gpu.requestAdapter())?.info;
+  const vendor = [info?.vendor, info?.architecture].filter(Boolean).join(" ");
+  const name = vendor ? `${vendor} — ${adapter.name}` : adapter.name;
+  document.body.dataset.adapter = name;
+  show($("adapter"), `${name} (${adapter.device_type === "Cpu" ? "software" : "hardware"} WebGPU)\n` +
     `largest storage binding ${(adapter.max_storage_buffer_binding_size / 2 ** 20).toFixed(0)} MiB, ` +
     `${adapter.max_compute_workgroups_per_dimension} workgroups per dimension`, "ok");
 

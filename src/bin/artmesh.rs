@@ -185,10 +185,12 @@ mod cli {
             );
             for c in &report.checks {
                 let verdict = if c.passed() { "ok" } else { "MISMATCH" };
-                println!(
-                    "{:>10} n={:<9} bits={:<2} {verdict}",
-                    c.kernel, c.n, c.key_bits
-                );
+                let bits = if c.key_bits > 0 {
+                    format!("{}-bit keys", c.key_bits)
+                } else {
+                    String::new()
+                };
+                println!("{:>10}  n = {:<9} {bits:<12} {verdict}", c.kernel, c.n);
             }
         }
         Ok(if report.passed() {

@@ -118,8 +118,14 @@ impl GpuContext {
             }
         }));
 
+        // Browsers may hide the adapter's description (Chromium does): say so rather than print nothing.
+        let name = match (info.name.trim(), info.device_type) {
+            ("", wgpu::DeviceType::Cpu) => "unnamed software (fallback) adapter".to_string(),
+            ("", _) => "unnamed adapter".to_string(),
+            (name, _) => name.to_string(),
+        };
         let adapter = AdapterReport {
-            name: info.name.clone(),
+            name,
             backend: format!("{:?}", info.backend),
             device_type: format!("{:?}", info.device_type),
             driver: format!("{} {}", info.driver, info.driver_info)
