@@ -3,9 +3,16 @@
 // Invocations per workgroup in every kernel: the browser's limit (lavapipe allows 1024).
 const WG_SIZE: u32 = 256u;
 
+// The workgroup's place in the dispatch. Only workgroup-uniform builtins belong here: the
+// early returns built on it must keep the barriers that follow in uniform control flow.
+struct Workgroup {
+    @builtin(workgroup_id) id: vec3<u32>,
+    @builtin(num_workgroups) count: vec3<u32>,
+}
+
 // Linear workgroup index of a dispatch tiled in 2-D (see `GpuContext::workgroup_grid`).
-fn linear_workgroup(id: vec3<u32>, count: vec3<u32>) -> u32 {
-    return id.x + id.y * count.x;
+fn workgroup_index(wg: Workgroup) -> u32 {
+    return wg.id.x + wg.id.y * wg.count.x;
 }
 
 var<workgroup> wg_scan: array<u32, WG_SIZE>;

@@ -3,6 +3,12 @@
 // (hist[digit * num_blocks + block]), so its exclusive prefix sum (scan.wgsl) is directly each
 // (digit, block)'s first output slot; `scatter` ranks each block's keys stably by digit in
 // workgroup memory and writes them to those slots.
+//
+// Local ranking is two stable 16-way multi-splits (low nibble of the digit, then high nibble):
+// each invocation counts its keys per nibble value, one raking scan of those 16 counters
+// (packed two per u32) places every key. On lavapipe this is 1.4x faster than eight one-bit
+// splits (the cost is per round). Workgroup arrays are kept flat: an array of arrays indexed
+// per invocation gave wrong results on SwiftShader (Chromium 156) while lavapipe was right.
 
 const ITEMS: u32 = 4u;               // keys per invocation
 const BLOCK: u32 = WG_SIZE * ITEMS;  // keys per workgroup (1024: local ranks fit 16 bits)
@@ -27,17 +33,21 @@ var<workgroup> bins: array<atomic<u32>, RADIX>;
 var<workgroup> ranked: array<u32, BLOCK>;
 var<workgroup> digit_start: array<u32, RADIX>;
 
+// Multi-split state: 16 counters per invocation, two 16-bit counters per word (counts <= BLOCK).
+const BUCKETS: u32 = 16u;
+const PACKED: u32 = 8u;
+const RAKE: u32 = 16u;  // RAKE * RAKE = WG_SIZE
+var<workgroup> bucket_counts: array<u32, WG_SIZE * PACKED>;  // [invocation * PACKED + word]
+var<workgroup> rake_sums: array<u32, RAKE * PACKED>;          // [lane * PACKED + word]
+var<workgroup> bucket_base: array<u32, BUCKETS>;
+
 fn digit_of(key: u32) -> u32 {
     return (key >> params.shift) & (RADIX - 1u);
 }
 
 @compute @workgroup_size(WG_SIZE)
-fn count_digits(
-    @builtin(local_invocation_index) lid: u32,
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-) {
-    let block = linear_workgroup(wid, nwg);
+fn count_digits(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let block = workgroup_index(wg);
     if (block >= params.num_blocks) {
         return;
     }
@@ -54,12 +64,8 @@ fn count_digits(
 }
 
 @compute @workgroup_size(WG_SIZE)
-fn scatter(
-    @builtin(local_invocation_index) lid: u32,
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-) {
-    let block = linear_workgroup(wid, nwg);
+fn scatter(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let block = workgroup_index(wg);
     if (block >= params.num_blocks) {
         return;
     }
@@ -76,23 +82,70 @@ fn scatter(
         item[i] = (digit << 16u) | local;
     }
 
-    // Stable local sort by digit: one split per digit bit, zeros before ones, order kept.
-    for (var bit = 16u; bit < 24u; bit++) {
-        var zeros = 0u;
+    // Stable local sort by digit: low nibble first, then high nibble (LSD within the block).
+    for (var nibble_shift = 16u; nibble_shift < 24u; nibble_shift += 4u) {
+        // Each key's rank among this invocation's keys of equal nibble, and the invocation's
+        // 16 counters, from register comparisons (no index that depends on the data).
+        var nibble = array<u32, ITEMS>();
         for (var i = 0u; i < ITEMS; i++) {
-            zeros += 1u - ((item[i] >> bit) & 1u);
+            nibble[i] = (item[i] >> nibble_shift) & (BUCKETS - 1u);
         }
-        let scanned = workgroup_exclusive_scan(lid, zeros);
-        var next_zero = scanned.x;
-        var next_one = scanned.y + lid * ITEMS - scanned.x;
+        var rank_in_thread = array<u32, ITEMS>();
         for (var i = 0u; i < ITEMS; i++) {
-            if (((item[i] >> bit) & 1u) == 0u) {
-                ranked[next_zero] = item[i];
-                next_zero++;
-            } else {
-                ranked[next_one] = item[i];
-                next_one++;
+            var rank = 0u;
+            for (var j = 0u; j < i; j++) {
+                rank += u32(nibble[j] == nibble[i]);
             }
+            rank_in_thread[i] = rank;
+        }
+        for (var w = 0u; w < PACKED; w++) {
+            var packed = 0u;
+            for (var i = 0u; i < ITEMS; i++) {
+                packed += u32(nibble[i] == 2u * w) + (u32(nibble[i] == 2u * w + 1u) << 16u);
+            }
+            bucket_counts[lid * PACKED + w] = packed;
+        }
+        workgroupBarrier();
+        // Raking exclusive scan over invocations, all 16 counters at once.
+        if (lid < RAKE) {
+            for (var w = 0u; w < PACKED; w++) {
+                var sum = 0u;
+                for (var r = 0u; r < RAKE; r++) {
+                    let at = (lid * RAKE + r) * PACKED + w;
+                    let v = bucket_counts[at];
+                    bucket_counts[at] = sum;
+                    sum += v;
+                }
+                rake_sums[lid * PACKED + w] = sum;
+            }
+        }
+        workgroupBarrier();
+        if (lid == 0u) {
+            var base = 0u;
+            for (var w = 0u; w < PACKED; w++) {
+                var sum = 0u;
+                for (var r = 0u; r < RAKE; r++) {
+                    let v = rake_sums[r * PACKED + w];
+                    rake_sums[r * PACKED + w] = sum;
+                    sum += v;
+                }
+                bucket_base[2u * w] = sum & 0xffffu;
+                bucket_base[2u * w + 1u] = sum >> 16u;
+            }
+            // Totals per bucket -> first position of each bucket in the block.
+            for (var b = 0u; b < BUCKETS; b++) {
+                let total = bucket_base[b];
+                bucket_base[b] = base;
+                base += total;
+            }
+        }
+        workgroupBarrier();
+        for (var i = 0u; i < ITEMS; i++) {
+            let b = nibble[i];
+            let w = b >> 1u;
+            let packed = bucket_counts[lid * PACKED + w] + rake_sums[(lid / RAKE) * PACKED + w];
+            let before = (packed >> ((b & 1u) * 16u)) & 0xffffu;
+            ranked[bucket_base[b] + before + rank_in_thread[i]] = item[i];
         }
         workgroupBarrier();
         for (var i = 0u; i < ITEMS; i++) {

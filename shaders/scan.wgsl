@@ -17,12 +17,8 @@ struct ScanParams {
 @group(0) @binding(2) var<storage, read_write> block_sums: array<u32>;
 
 @compute @workgroup_size(WG_SIZE)
-fn scan_blocks(
-    @builtin(local_invocation_index) lid: u32,
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-) {
-    let block = linear_workgroup(wid, nwg);
+fn scan_blocks(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let block = workgroup_index(wg);
     if (block >= params.num_blocks) {
         return;
     }
@@ -48,12 +44,8 @@ fn scan_blocks(
 }
 
 @compute @workgroup_size(WG_SIZE)
-fn add_block_offsets(
-    @builtin(local_invocation_index) lid: u32,
-    @builtin(workgroup_id) wid: vec3<u32>,
-    @builtin(num_workgroups) nwg: vec3<u32>,
-) {
-    let block = linear_workgroup(wid, nwg);
+fn add_block_offsets(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let block = workgroup_index(wg);
     if (block >= params.num_blocks) {
         return;
     }

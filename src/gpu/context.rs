@@ -40,6 +40,20 @@ pub enum GpuError {
     Readback(String),
 }
 
+impl GpuError {
+    /// `Err(TooManyElements)` when `n` exceeds the `capacity` a kernel's buffers were sized for.
+    pub(crate) fn check_capacity(what: &str, n: u32, capacity: u32) -> GpuResult<()> {
+        if n > capacity {
+            return Err(GpuError::TooManyElements {
+                what: what.to_string(),
+                count: n.into(),
+                max: capacity.into(),
+            });
+        }
+        Ok(())
+    }
+}
+
 /// The adapter in words, for `artmesh gpu`, the web page and benchmark output.
 #[derive(Debug, Clone, Serialize)]
 pub struct AdapterReport {

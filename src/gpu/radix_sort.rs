@@ -132,13 +132,7 @@ impl RadixSort {
         n: u32,
         key_bits: u32,
     ) -> GpuResult<()> {
-        if n > self.capacity {
-            return Err(GpuError::TooManyElements {
-                what: "radix sort".into(),
-                count: n.into(),
-                max: self.capacity.into(),
-            });
-        }
+        GpuError::check_capacity("radix sort", n, self.capacity)?;
         if n <= 1 {
             return Ok(());
         }

@@ -96,13 +96,7 @@ impl PrefixSum {
         encoder: &mut wgpu::CommandEncoder,
         n: u32,
     ) -> GpuResult<()> {
-        if n > self.capacity {
-            return Err(GpuError::TooManyElements {
-                what: "prefix sum".into(),
-                count: n.into(),
-                max: self.capacity.into(),
-            });
-        }
+        GpuError::check_capacity("prefix sum", n, self.capacity)?;
         let mut blocks = Vec::with_capacity(self.levels.len());
         let mut len = n;
         for level in &self.levels {
