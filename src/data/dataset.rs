@@ -591,18 +591,24 @@ fn write_view_set(
                 image_io::PngPixels::Rgba8(&frame.rgba.pixels),
             )?,
         );
+        // Depth and part maps must match their colour frame pixel for pixel.
+        let same_size = |path: &str, width: u32, height: u32| -> Result<(), DataError> {
+            if (width, height) == (frame.rgba.width, frame.rgba.height) {
+                return Ok(());
+            }
+            let expected = format!("the size of {rgba_path}");
+            Err(size_error(
+                path,
+                &expected,
+                frame.rgba.width,
+                frame.rgba.height,
+                width,
+                height,
+            ))
+        };
         if let Some(d) = &frame.depth {
             let path = transforms::frame_path(view, "depth", &frame.name, ".png");
-            if (d.width, d.height) != (frame.rgba.width, frame.rgba.height) {
-                return Err(size_error(
-                    &path,
-                    &format!("the size of {rgba_path}"),
-                    frame.rgba.width,
-                    frame.rgba.height,
-                    d.width,
-                    d.height,
-                ));
-            }
+            same_size(&path, d.width, d.height)?;
             let png = image_io::encode_png(
                 &path,
                 d.width,
@@ -617,16 +623,7 @@ fn write_view_set(
                 SemanticFormat::Npy => ".npy",
             };
             let path = transforms::frame_path(view, "semantic", &frame.name, ext);
-            if (m.width, m.height) != (frame.rgba.width, frame.rgba.height) {
-                return Err(size_error(
-                    &path,
-                    &format!("the size of {rgba_path}"),
-                    frame.rgba.width,
-                    frame.rgba.height,
-                    m.width,
-                    m.height,
-                ));
-            }
+            same_size(&path, m.width, m.height)?;
             let expected_len = u64::from(m.width) * u64::from(m.height);
             if m.ids.len() as u64 != expected_len || m.ids.iter().any(|&id| id < -1) {
                 return Err(DataError::field(

@@ -37,33 +37,24 @@ impl IntrinsicsSpec {
         map: &Map<String, Value>,
         errs: &mut Errors,
     ) -> IntrinsicsSpec {
-        let positive = |key: &str, errs: &mut Errors| -> Option<f64> {
+        // A number that must satisfy `valid`; otherwise the error says what was `expected`.
+        let checked = |key: &str, valid: fn(f64) -> bool, expected: &str, errs: &mut Errors| {
             let v = optional(map, key)?;
             let field = json::join(prefix, key);
             let x = errs.keep(j.number(&field, v))?;
-            if x > 0.0 {
+            if valid(x) {
                 Some(x)
             } else {
-                errs.push(j.err(
-                    &field,
-                    format!("expected a positive focal length in pixels, found {x}"),
-                ));
+                errs.push(j.err(&field, format!("expected {expected}, found {x}")));
                 None
             }
         };
-        let angle = |key: &str, errs: &mut Errors| -> Option<f64> {
-            let v = optional(map, key)?;
-            let field = json::join(prefix, key);
-            let x = errs.keep(j.number(&field, v))?;
-            if x > 0.0 && x < std::f64::consts::PI {
-                Some(x)
-            } else {
-                errs.push(j.err(
-                    &field,
-                    format!("expected an angle in radians in (0, π), found {x}"),
-                ));
-                None
-            }
+        let positive = |key: &str, errs: &mut Errors| {
+            checked(key, |x| x > 0.0, "a positive focal length in pixels", errs)
+        };
+        let angle = |key: &str, errs: &mut Errors| {
+            let in_range = |x: f64| x > 0.0 && x < std::f64::consts::PI;
+            checked(key, in_range, "an angle in radians in (0, π)", errs)
         };
         let any = |key: &str, errs: &mut Errors| -> Option<f64> {
             let v = optional(map, key)?;
