@@ -6,6 +6,7 @@
 //! file-system access lives only in the CLI and in native-only helpers.
 
 pub mod data;
+pub mod eval;
 pub mod gpu;
 pub mod rng;
 
