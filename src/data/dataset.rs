@@ -217,23 +217,7 @@ impl Dataset {
                 ),
             ));
         }
-        if let Some(joints) = &self.gt_joints {
-            out.insert(GT_TRANS_PATH.into(), gt::write_trans(joints));
-        }
-        for state in State::ALL {
-            if let Some(m) = &self.gt_meshes[state.index()] {
-                out.insert(
-                    gt::static_mesh_path(state),
-                    m.static_part.to_ply(PlyFormat::BinaryLittleEndian),
-                );
-                for (i, mesh) in m.movable.iter().enumerate() {
-                    out.insert(
-                        gt::movable_mesh_path(state, i),
-                        mesh.to_ply(PlyFormat::BinaryLittleEndian),
-                    );
-                }
-            }
-        }
+        write_ground_truth(self.gt_joints.as_deref(), &self.gt_meshes, &mut out);
         Ok(out)
     }
 
@@ -449,6 +433,68 @@ fn read_frame(
 }
 
 /// Reads `gt/{state}/...ply`; `None` when the state has no GT mesh files.
+/// Joints and part meshes alone, in the layout of a dataset's `gt/` folder: the ground truth of a
+/// dataset, or a prediction written the same way. `artmesh eval` reads both sides with it.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct GroundTruth {
+    /// Joints from `gt/trans.json`, one per movable part.
+    pub joints: Option<Vec<GtJoint>>,
+    /// Part meshes per state, indexed by [`State::index`].
+    pub meshes: [Option<GtMeshes>; 2],
+}
+
+impl GroundTruth {
+    /// Reads `gt/trans.json` and the `gt/{state}/` meshes, ignoring every other file. With joints
+    /// present, each state's meshes must cover exactly the movable parts they describe.
+    pub fn from_files(files: &FileSet) -> Result<GroundTruth, DatasetErrors> {
+        let mut errs = Errors::default();
+        let joints = files
+            .get(GT_TRANS_PATH)
+            .and_then(|b| gt::parse_trans(b, &mut errs));
+        let meshes = State::ALL.map(|s| read_gt_meshes(files, s, &mut errs));
+        if let Some(joints) = &joints {
+            for (state, m) in State::ALL.iter().zip(&meshes) {
+                if let Some(m) = m {
+                    check_mesh_count(*state, m.movable.len(), joints.len() + 1, true, &mut errs);
+                }
+            }
+        }
+        if joints.is_none() && meshes.iter().all(Option::is_none) {
+            errs.push(DataError::file(
+                GT_TRANS_PATH,
+                "missing: found neither joints nor part meshes (gt/trans.json, gt/{start,end}/*.ply)",
+            ));
+        }
+        errs.finish(GroundTruth { joints, meshes })
+    }
+
+    /// Writes `gt/trans.json` and the meshes (binary PLY) in the layout [`GroundTruth::from_files`] reads.
+    pub fn to_files(&self) -> FileSet {
+        let mut out = FileSet::new();
+        write_ground_truth(self.joints.as_deref(), &self.meshes, &mut out);
+        out
+    }
+}
+
+fn write_ground_truth(
+    joints: Option<&[GtJoint]>,
+    meshes: &[Option<GtMeshes>; 2],
+    out: &mut FileSet,
+) {
+    if let Some(joints) = joints {
+        out.insert(GT_TRANS_PATH.into(), gt::write_trans(joints));
+    }
+    for state in State::ALL {
+        if let Some(m) = &meshes[state.index()] {
+            let ply = |mesh: &TriMesh| mesh.to_ply(PlyFormat::BinaryLittleEndian);
+            out.insert(gt::static_mesh_path(state), ply(&m.static_part));
+            for (i, mesh) in m.movable.iter().enumerate() {
+                out.insert(gt::movable_mesh_path(state, i), ply(mesh));
+            }
+        }
+    }
+}
+
 fn read_gt_meshes(files: &FileSet, state: State, errs: &mut Errors) -> Option<GtMeshes> {
     let prefix = format!("gt/{0}/{0}_dynamic_", state.name());
     let mut indexed: BTreeSet<usize> = BTreeSet::new();

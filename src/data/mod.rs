@@ -33,7 +33,7 @@ mod transforms;
 use std::collections::BTreeMap;
 
 pub use camera::{Camera, Intrinsics, look_at};
-pub use dataset::{Dataset, Frame, SemanticFormat, ViewSet, WriteOptions};
+pub use dataset::{Dataset, Frame, GroundTruth, SemanticFormat, ViewSet, WriteOptions};
 pub use error::{DataError, DatasetErrors};
 #[cfg(not(target_arch = "wasm32"))]
 pub use fs::{read_dir, write_dir};
