@@ -7,6 +7,7 @@
 
 pub mod data;
 pub mod gpu;
+pub mod object;
 pub mod rng;
 
 #[cfg(not(target_arch = "wasm32"))]
