@@ -23,14 +23,14 @@ pub const MERGE_REVOLUTE_SPAN: f32 = 2.0 * std::f32::consts::PI / 180.0;
 /// One rigid part.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Part {
-    /// Links of the part, in breadth-first order from the part's first link.
+    /// Links of the part, in breadth-first order from the root.
     pub links: Vec<usize>,
     /// The movable joint whose child starts this part; `None` for part 0 (the static base).
     pub joint: Option<usize>,
 }
 
-/// The object's parts. Part 0 holds the root link; the others follow in breadth-first order of their joints
-/// (file order among siblings).
+/// The object's parts. Part 0 holds the root link; the others follow the file order of the joints that start
+/// them.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct Parts {
     /// The parts; `parts[0]` is the static base.
@@ -103,12 +103,28 @@ pub fn is_merged_chain_joint(object: &ArticulatedObject, j: usize) -> bool {
 
 pub(super) fn parts(object: &ArticulatedObject) -> Parts {
     let (order, _) = kinematics::joint_order(object);
-    let mut link_part = vec![0usize; object.links.len()];
+    // Part numbers follow the file order of the joints that start them, whatever their depth in the tree.
+    let mut part_of_joint = vec![None; object.joints.len()];
     let mut parts = vec![Part {
         links: Vec::new(),
         joint: None,
     }];
     let mut merged_joints = Vec::new();
+    for (j, joint) in object.joints.iter().enumerate() {
+        if !joint.kind.is_movable() {
+            continue;
+        }
+        if is_merged_chain_joint(object, j) {
+            merged_joints.push(j);
+        } else {
+            part_of_joint[j] = Some(parts.len());
+            parts.push(Part {
+                links: Vec::new(),
+                joint: Some(j),
+            });
+        }
+    }
+    let mut link_part = vec![0usize; object.links.len()];
     if object.root < object.links.len() {
         parts[0].links.push(object.root);
     }
@@ -116,20 +132,11 @@ pub(super) fn parts(object: &ArticulatedObject) -> Parts {
         let Some(joint) = object.joints.get(j) else {
             continue;
         };
-        let parent_part = link_part.get(joint.parent).copied().unwrap_or(0);
-        let starts_part = joint.kind.is_movable() && !is_merged_chain_joint(object, j);
-        if joint.kind.is_movable() && !starts_part {
-            merged_joints.push(j);
-        }
-        let part = if starts_part {
-            parts.push(Part {
-                links: Vec::new(),
-                joint: Some(j),
-            });
-            parts.len() - 1
-        } else {
-            parent_part
-        };
+        let part = part_of_joint
+            .get(j)
+            .copied()
+            .flatten()
+            .unwrap_or_else(|| link_part.get(joint.parent).copied().unwrap_or(0));
         if let Some(slot) = link_part.get_mut(joint.child) {
             *slot = part;
         }
