@@ -507,6 +507,7 @@ fn object_bad_mesh_references_are_clear_errors() {
     };
     let e = ArticulatedObject::from_urdf(urdf, &corrupt).unwrap_err();
     assert_eq!(e.file, "habitat/fridge/top_door.glb");
+    assert!(e.message.contains("mesh of habitat/fridge/fridge.urdf at robot/link[name=top_door]/visual[0]/geometry/mesh, line 96"), "{e}");
 
     let corrupt_obj = {
         let mut f = objects().clone();
@@ -564,4 +565,57 @@ fn object_joint_limits_rules() {
         Some((-std::f32::consts::PI, std::f32::consts::PI))
     );
     assert_eq!(o.parts().parts.len(), 3);
+}
+
+/// Truncated and bit-flipped mesh files give errors or meshes, never panics.
+#[test]
+fn object_corrupt_mesh_files_never_panic() {
+    use artmesh::object::load_mesh;
+    let sources = [
+        "habitat/doors/door1.glb",
+        "sektion/meshes/door_left.obj",
+        "sektion/meshes/door_left.stl",
+        "sektion/meshes/drawer_convexdecomposition0.obj",
+    ];
+    for src in sources {
+        let bytes = &objects()[src];
+        let mut cases: Vec<Vec<u8>> = [
+            0,
+            1,
+            12,
+            20,
+            84,
+            100,
+            1000,
+            bytes.len() / 2,
+            bytes.len() - 1,
+        ]
+        .iter()
+        .filter(|&&n| n < bytes.len())
+        .map(|&n| bytes[..n].to_vec())
+        .collect();
+        // Flip bytes in the header region (GLB chunk lengths, JSON, STL counts, OBJ indices).
+        for at in [8, 12, 16, 24, 40, 81, 83, 200, 400] {
+            if at < bytes.len() {
+                let mut b = bytes.clone();
+                b[at] ^= 0xA5;
+                cases.push(b);
+            }
+        }
+        for case in cases {
+            let mut files = FileSet::new();
+            let len = case.len();
+            files.insert(src.to_string(), case);
+            let result = load_mesh(src, &files, &mut Vec::new());
+            if let Ok(meshes) = result {
+                for m in meshes {
+                    let n = m.positions.len();
+                    assert!(
+                        m.indices.iter().flatten().all(|&i| (i as usize) < n),
+                        "{src} @ {len}"
+                    );
+                }
+            }
+        }
+    }
 }

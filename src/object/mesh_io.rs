@@ -89,6 +89,7 @@ fn folder_of(path: &str) -> &str {
 /// Joins `rel` to `folder` (which ends with '/' or is empty), resolving `.` and `..`; `None` if the result
 /// would leave the file-set root or `rel` is absolute.
 pub(super) fn join_relative(folder: &str, rel: &str) -> Option<String> {
+    // Backslashes and ':' (Windows separators and drive letters) would escape the '/'-keyed file set's rules.
     if rel.starts_with('/') || rel.contains('\\') || rel.contains(':') {
         return None;
     }
@@ -122,7 +123,6 @@ fn read_obj(
         triangulate: true,
         ignore_points: true,
         ignore_lines: true,
-        ..Default::default()
     };
     // The loader closure is `Fn`; collect its notes and the MTL's location through cells.
     let notes = std::cell::RefCell::new(Vec::<String>::new());
@@ -718,8 +718,8 @@ impl GltfReader<'_> {
         let mut out = Vec::with_capacity(raw.len() * comps);
         for elem in raw {
             for c in 0..comps {
-                let b = elem.get(c * size..(c + 1) * size).unwrap_or(&[]);
-                let v = match (acc.data_type(), b) {
+                let bytes = elem.get(c * size..(c + 1) * size).unwrap_or(&[]);
+                let v = match (acc.data_type(), bytes) {
                     (DataType::F32, &[a, b, c, d]) => f32::from_le_bytes([a, b, c, d]),
                     (DataType::U8, &[a]) if normalized => f32::from(a) / 255.0,
                     (DataType::U8, &[a]) => f32::from(a),

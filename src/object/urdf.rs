@@ -355,7 +355,18 @@ impl Reader<'_, '_> {
             Some(m) => m.clone(),
             None => {
                 let loaded: Arc<[RenderMesh]> =
-                    mesh_io::load_mesh(&key, self.files, &mut self.warnings)?.into();
+                    match mesh_io::load_mesh(&key, self.files, &mut self.warnings) {
+                        Ok(m) => m.into(),
+                        Err(mut e) => {
+                            // The mesh file is at fault; say where the URDF refers to it.
+                            let line = self.doc.text_pos_at(node.range().start).row;
+                            e.message = format!(
+                                "{} (mesh of {} at {path}, line {line})",
+                                e.message, self.file
+                            );
+                            return Err(e);
+                        }
+                    };
                 self.meshes.insert(key.clone(), loaded.clone());
                 loaded
             }
