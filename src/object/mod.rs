@@ -18,6 +18,9 @@
 //! - Revolute and prismatic joints without `<limit>` are an error (the URDF spec requires one, and without it
 //!   there is no state range to sample); missing `lower`/`upper` default to 0 and missing `effort`/`velocity`
 //!   to 0, as in the URDF spec's defaults.
+//! - Numbers in vectors are whitespace-separated (URDF spec). Only mesh `scale` also accepts commas
+//!   (`"1, 1, 1"`, written throughout habitat-sim's assets); `origin@xyz="0.01, -0.33, 0"` is an error.
+//! - Chained joints (a hinge behind a tiny slider) are merged in the part view; see [`Parts`] / `parts.rs`.
 //!
 //! The module is I/O-free: bytes in, structs out, so it runs natively and in wasm. Bad input never panics:
 //! every problem is a [`DataError`] naming the file, the element path (`robot/joint[name=hinge]/limit@lower`)
