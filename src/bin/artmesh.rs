@@ -11,10 +11,11 @@ fn main() -> std::process::ExitCode {
 
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
-    use std::path::PathBuf;
+    use std::path::{Path, PathBuf};
     use std::process::ExitCode;
 
-    use artmesh::data::{self, Dataset, fixture};
+    use artmesh::data::{self, Dataset, GroundTruth, State, fixture};
+    use artmesh::eval;
     use artmesh::gpu::{GpuContext, selftest};
     use clap::{Parser, Subcommand};
 
@@ -65,6 +66,27 @@ mod cli {
             #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=15))]
             parts: u8,
         },
+        /// Score predicted joints and part meshes against ground truth with the metrics of the
+        /// paper's tables (Axis Ang, Axis Pos, Part Motion, CD-s, CD-m); prints JSON.
+        Eval {
+            /// Prediction: a folder laid out like a dataset's gt/ folder (trans.json,
+            /// {start,end}/{state}_static_rotate.ply, {state}_dynamic_{i}_rotate.ply), or one that contains gt/.
+            pred: PathBuf,
+            /// Ground truth: a dataset folder (its gt/ is used) or a gt/ folder.
+            gt: PathBuf,
+            /// State whose part meshes are compared (the paper reports the start state).
+            #[arg(long, default_value = "start", value_parser = ["start", "end"])]
+            state: String,
+            /// Object name written in the report (default: the ground-truth folder's name).
+            #[arg(long)]
+            id: Option<String>,
+            /// Object category written in the report.
+            #[arg(long, default_value = "unknown")]
+            category: String,
+            /// Area-weighted surface samples per mesh for the Chamfer distances.
+            #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
+            samples: u32,
+        },
         /// Benchmarks that print machine-readable JSON.
         Bench {
             #[command(subcommand)]
@@ -86,6 +108,14 @@ mod cli {
             #[arg(long, default_value_t = 5)]
             repeats: usize,
         },
+    }
+
+    /// `println!` that treats a closed stdout (`artmesh ... | head`) as done instead of panicking.
+    macro_rules! out {
+        ($($arg:tt)*) => {{
+            use std::io::Write as _;
+            let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+        }};
     }
 
     pub fn main() -> ExitCode {
@@ -122,7 +152,25 @@ mod cli {
                     .to_files()
                     .map_err(|e| e.to_string())?;
                 data::write_dir(&files, &out).map_err(|e| e.to_string())?;
-                println!("wrote {} files to {}", files.len(), out.display());
+                out!("wrote {} files to {}", files.len(), out.display());
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Eval {
+                pred,
+                gt,
+                state,
+                id,
+                category,
+                samples,
+            } => {
+                let state = if state == "end" {
+                    State::End
+                } else {
+                    State::Start
+                };
+                let id = id.unwrap_or_else(|| folder_name(&gt));
+                let report = evaluate(&pred, &gt, state, &id, &category, samples)?;
+                out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
             Command::Bench {
@@ -136,7 +184,7 @@ mod cli {
                 let ctx = context()?;
                 let report = artmesh::bench::sort(&ctx, &sizes, key_bits, repeats)
                     .map_err(|e| e.to_string())?;
-                println!("{}", to_json(&report)?);
+                out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
         }
@@ -148,9 +196,9 @@ mod cli {
             Ok(dataset) => {
                 let summary = dataset.summary();
                 if json {
-                    println!("{}", to_json(&summary)?);
+                    out!("{}", to_json(&summary)?);
                 } else {
-                    println!("{}\n{summary}", root.display());
+                    out!("{}\n{summary}", root.display());
                 }
                 Ok(ExitCode::SUCCESS)
             }
@@ -162,6 +210,56 @@ mod cli {
         }
     }
 
+    /// Reads a gt/-style folder (or a folder containing gt/) as [`GroundTruth`].
+    fn read_ground_truth(root: &Path) -> Result<GroundTruth, String> {
+        let files = data::read_dir(root).map_err(|e| e.to_string())?;
+        let files = if files.keys().any(|k| k.starts_with("gt/")) {
+            files
+        } else {
+            files
+                .into_iter()
+                .map(|(k, v)| (format!("gt/{k}"), v))
+                .collect()
+        };
+        GroundTruth::from_files(&files).map_err(|e| format!("{}:\n{e}", root.display()))
+    }
+
+    fn evaluate(
+        pred: &Path,
+        gt: &Path,
+        state: State,
+        id: &str,
+        category: &str,
+        samples: u32,
+    ) -> Result<eval::ObjectMetrics, String> {
+        let (pred, gt_data) = (read_ground_truth(pred)?, read_ground_truth(gt)?);
+        let (Some(pred_joints), Some(gt_joints)) = (&pred.joints, &gt_data.joints) else {
+            return Err("both the prediction and the ground truth need joints (trans.json)".into());
+        };
+        let meshes = match (&pred.meshes[state.index()], &gt_data.meshes[state.index()]) {
+            (Some(p), Some(g)) => Some((p, g)),
+            _ => {
+                eprintln!("artmesh: no {state} part meshes on both sides: joint metrics only");
+                None
+            }
+        };
+        let options = eval::EvalOptions {
+            chamfer: eval::ChamferOptions {
+                samples: samples as usize,
+                ..Default::default()
+            },
+        };
+        eval::evaluate_object(id, category, pred_joints, gt_joints, meshes, &options)
+            .map_err(|e| e.to_string())
+    }
+
+    fn folder_name(path: &Path) -> String {
+        path.file_name().map_or_else(
+            || path.display().to_string(),
+            |n| n.to_string_lossy().into_owned(),
+        )
+    }
+
     fn gpu(max_size: u32, json: bool) -> Result<ExitCode, String> {
         let ctx = context()?;
         let sizes: Vec<u32> = selftest::DEFAULT_SIZES
@@ -171,14 +269,17 @@ mod cli {
             .collect();
         let report = pollster::block_on(selftest::run(&ctx, &sizes)).map_err(|e| e.to_string())?;
         if json {
-            println!("{}", to_json(&report)?);
+            out!("{}", to_json(&report)?);
         } else {
             let a = &report.adapter;
-            println!(
+            out!(
                 "adapter: {} ({}, {}, driver {})",
-                a.name, a.backend, a.device_type, a.driver
+                a.name,
+                a.backend,
+                a.device_type,
+                a.driver
             );
-            println!(
+            out!(
                 "limits: storage binding {} MiB, {} workgroups per dimension",
                 a.max_storage_buffer_binding_size >> 20,
                 a.max_compute_workgroups_per_dimension
@@ -190,7 +291,7 @@ mod cli {
                 } else {
                     String::new()
                 };
-                println!("{:>10}  n = {:<9} {bits:<12} {verdict}", c.kernel, c.n);
+                out!("{:>10}  n = {:<9} {bits:<12} {verdict}", c.kernel, c.n);
             }
         }
         Ok(if report.passed() {
