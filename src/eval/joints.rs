@@ -249,12 +249,12 @@ pub fn match_joints_using(
         })
         .collect();
     let small = pred.len().max(gt.len()) <= BRUTE_FORCE_MAX_JOINTS;
-    let assignment = match solver {
-        Solver::Auto | Solver::BruteForce if small => {
-            assign_brute_force(&metrics, pred.len(), gt.len())
-        }
-        _ => assign_hungarian(&metrics, pred.len(), gt.len()),
+    let oriented = Oriented::new(&metrics, pred.len(), gt.len());
+    let col_of_row = match solver {
+        Solver::Auto | Solver::BruteForce if small => assign_brute_force(&oriented),
+        _ => assign_hungarian(&oriented),
     };
+    let assignment = oriented.assignment(&col_of_row, pred.len());
     Ok(build_matching(metrics, &assignment, pred.len(), gt.len()))
 }
 
@@ -293,24 +293,54 @@ fn build_matching(
 #[derive(Debug, Clone, Copy, PartialEq, PartialOrd)]
 struct Cost(usize, f64);
 
-/// Exhaustive search over all injective assignments of the smaller side into the larger one.
-/// Returns `assignment[p] = Some(g)` per predicted joint.
-fn assign_brute_force(
-    metrics: &[Vec<JointPairMetrics>],
-    n_pred: usize,
-    n_gt: usize,
-) -> Vec<Option<usize>> {
-    // Rows = the smaller side, so every row is matched.
-    let transposed = n_pred > n_gt;
-    let (rows, cols) = if transposed {
-        (n_gt, n_pred)
-    } else {
-        (n_pred, n_gt)
-    };
-    let pair = |r: usize, c: usize| {
-        let (p, g) = if transposed { (c, r) } else { (r, c) };
-        &metrics[p][g]
-    };
+/// The pair metrics seen with the smaller side as rows, so that every row gets a column.
+struct Oriented<'a> {
+    metrics: &'a [Vec<JointPairMetrics>],
+    transposed: bool,
+    rows: usize,
+    cols: usize,
+}
+
+impl<'a> Oriented<'a> {
+    fn new(metrics: &'a [Vec<JointPairMetrics>], n_pred: usize, n_gt: usize) -> Self {
+        let transposed = n_pred > n_gt;
+        let (rows, cols) = if transposed {
+            (n_gt, n_pred)
+        } else {
+            (n_pred, n_gt)
+        };
+        Self {
+            metrics,
+            transposed,
+            rows,
+            cols,
+        }
+    }
+
+    fn pred_gt(&self, r: usize, c: usize) -> (usize, usize) {
+        if self.transposed { (c, r) } else { (r, c) }
+    }
+
+    fn pair(&self, r: usize, c: usize) -> &'a JointPairMetrics {
+        let (p, g) = self.pred_gt(r, c);
+        &self.metrics[p][g]
+    }
+
+    /// `col_of_row` back to `assignment[p] = Some(g)` per predicted joint.
+    fn assignment(&self, col_of_row: &[usize], n_pred: usize) -> Vec<Option<usize>> {
+        let mut assignment = vec![None; n_pred];
+        for (r, &c) in col_of_row.iter().enumerate() {
+            let (p, g) = self.pred_gt(r, c);
+            assignment[p] = Some(g);
+        }
+        assignment
+    }
+}
+
+/// Exhaustive search over all injective assignments of rows to columns; returns the column per row.
+fn assign_brute_force(oriented: &Oriented<'_>) -> Vec<usize> {
+    let (rows, cols) = (oriented.rows, oriented.cols);
+    let pair = |r: usize, c: usize| oriented.pair(r, c);
     struct Search<'a, F: Fn(usize, usize) -> &'a JointPairMetrics> {
         rows: usize,
         cols: usize,
@@ -358,33 +388,15 @@ fn assign_brute_force(
         best: None,
     };
     search.go(0, Cost(0, 0.0));
-    let chosen = search.best.map(|(_, cols)| cols).unwrap_or_default();
-    let mut assignment = vec![None; n_pred];
-    for (r, &c) in chosen.iter().enumerate() {
-        let (p, g) = if transposed { (c, r) } else { (r, c) };
-        assignment[p] = Some(g);
-    }
-    assignment
+    search.best.map(|(_, cols)| cols).unwrap_or_default()
 }
 
 /// The same optimum by the Hungarian algorithm (shortest augmenting paths with potentials, O(n²m)).
 /// Type errors are made to dominate by a penalty larger than any possible total error.
-fn assign_hungarian(
-    metrics: &[Vec<JointPairMetrics>],
-    n_pred: usize,
-    n_gt: usize,
-) -> Vec<Option<usize>> {
-    let transposed = n_pred > n_gt;
-    let (rows, cols) = if transposed {
-        (n_gt, n_pred)
-    } else {
-        (n_pred, n_gt)
-    };
-    let pair = |r: usize, c: usize| {
-        let (p, g) = if transposed { (c, r) } else { (r, c) };
-        &metrics[p][g]
-    };
-    let max_error = metrics
+fn assign_hungarian(oriented: &Oriented<'_>) -> Vec<usize> {
+    let (rows, cols) = (oriented.rows, oriented.cols);
+    let max_error = oriented
+        .metrics
         .iter()
         .flatten()
         .map(JointPairMetrics::total_error)
@@ -392,16 +404,10 @@ fn assign_hungarian(
     // One type error more must cost more than any difference in total error between two assignments.
     let penalty = 2.0 * (rows as f64 * max_error + 1.0);
     let cost = |r: usize, c: usize| {
-        let m = pair(r, c);
+        let m = oriented.pair(r, c);
         m.total_error() + if m.type_correct { 0.0 } else { penalty }
     };
-    let col_of = hungarian(rows, cols, cost);
-    let mut assignment = vec![None; n_pred];
-    for (r, c) in col_of.into_iter().enumerate() {
-        let (p, g) = if transposed { (c, r) } else { (r, c) };
-        assignment[p] = Some(g);
-    }
-    assignment
+    hungarian(rows, cols, cost)
 }
 
 /// Minimum-cost assignment of every row (`rows ≤ cols`) to a distinct column; returns the column per row.
