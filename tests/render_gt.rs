@@ -431,3 +431,55 @@ fn sektion_cabinet_renders_parts_at_two_states() {
     let png = encode_png("render-sektion.png", W, H, PngPixels::Rgba8(&b.rgba.pixels)).unwrap();
     std::fs::write(dir.join("render-sektion.png"), png).unwrap();
 }
+
+#[test]
+fn textures_are_sampled_with_gltf_orientation() {
+    let ctx = context();
+    // 8×8 texture in four 4×4 quadrants: red, green / blue, white (top row first); blocks, not single texels,
+    // so bilinear filtering near a quadrant centre reads one colour. The +z face shows it upright from above.
+    let quadrant = [
+        [255, 0, 0, 255],
+        [0, 255, 0, 255],
+        [0, 0, 255, 255],
+        [255; 4],
+    ];
+    let pixels = (0..8)
+        .flat_map(|y| (0..8).map(move |x| quadrant[(y / 4) * 2 + x / 4]))
+        .flatten()
+        .collect();
+    let texture = std::sync::Arc::new(artmesh::data::RgbaImage {
+        width: 8,
+        height: 8,
+        pixels,
+    });
+    let material = Material {
+        name: Some("checker".into()),
+        base_color: [1.0; 4],
+        texture: Some(texture),
+    };
+    let mesh = box_mesh(Vec3::new(0.6, 0.6, 0.1), material);
+    let camera = Camera {
+        camera_to_world: look_at(Vec3::new(0.0, 0.0, 1.5), Vec3::ZERO, Vec3::Y),
+        intrinsics: intrinsics(),
+    };
+    let view = render(&ctx, &[PartMesh { mesh, part: 0 }], &camera);
+    // Quadrant centres at (±0.15, ±0.15) on the top face (z = 0.05).
+    let expect = [
+        (Vec3::new(-0.15, 0.15, 0.05), [255, 0, 0]),
+        (Vec3::new(0.15, 0.15, 0.05), [0, 255, 0]),
+        (Vec3::new(-0.15, -0.15, 0.05), [0, 0, 255]),
+        (Vec3::new(0.15, -0.15, 0.05), [255, 255, 255]),
+    ];
+    for (p, rgb) in expect {
+        let (px, _) = camera.project(p).unwrap();
+        let i = ((px.y as u32) * W + px.x as u32) as usize;
+        let got = &view.rgba.pixels[i * 4..i * 4 + 4];
+        for c in 0..3 {
+            assert!(
+                (got[c] as i32 - rgb[c]).abs() < 8,
+                "at {p}: got {got:?}, expected about {rgb:?}"
+            );
+        }
+        assert_eq!(got[3], 255);
+    }
+}

@@ -23,12 +23,13 @@ use std::collections::hash_map::Entry;
 use std::sync::Arc;
 
 use bytemuck::{Pod, Zeroable};
-use glam::Mat4;
+use glam::{Mat4, Vec3};
 use wgpu::util::DeviceExt;
 
-use crate::data::{Camera, DepthMap, PartMap, RgbaImage};
+use crate::data::{Camera, DepthMap, PartMap, RgbaImage, look_at};
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 use crate::object::{ArticulatedObject, RenderMesh};
+use crate::rng::Rng;
 
 const SHADER: &str = include_str!("../../shaders/render_gt.wgsl");
 
@@ -665,11 +666,36 @@ pub fn posed_part_meshes(obj: &ArticulatedObject, q: &[f32]) -> Vec<PartMesh> {
         .collect()
 }
 
+/// `n` camera-to-world poses (OpenGL axes) on a sphere of `radius` around `centre`, each looking at `centre`
+/// with world +z up in the image. Directions are uniform on the sphere, or on its upper half (`z ≥ centre.z`,
+/// the z-up convention of the datasets) when `upper_hemisphere` is set. The same seed gives the same poses.
+/// Directions within ~0.5° of the poles use +y as the up hint so the pose stays well defined.
+pub fn sample_views(
+    n: usize,
+    centre: Vec3,
+    radius: f32,
+    seed: u64,
+    upper_hemisphere: bool,
+) -> Vec<Mat4> {
+    let mut rng = Rng::new(seed);
+    (0..n)
+        .map(|_| {
+            // Uniform on the sphere: z uniform in [−1, 1] (or [0, 1]), azimuth uniform.
+            let u = rng.next_f32();
+            let z = if upper_hemisphere { u } else { 2.0 * u - 1.0 };
+            let phi = std::f32::consts::TAU * rng.next_f32();
+            let r = (1.0 - z * z).max(0.0).sqrt();
+            let dir = Vec3::new(r * phi.cos(), r * phi.sin(), z);
+            let up = if z.abs() > 0.99996 { Vec3::Y } else { Vec3::Z };
+            look_at(centre + dir * radius, centre, up)
+        })
+        .collect()
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::data::Intrinsics;
-    use glam::Vec3;
 
     #[test]
     fn near_far_brackets_scene() {
@@ -689,5 +715,28 @@ mod tests {
         let mut mesh = crate::object::box_mesh(Vec3::ONE, Default::default());
         mesh.indices.push([0, 1, 99]);
         assert!(vertices_of(3, &mesh).is_err());
+    }
+
+    #[test]
+    fn sampled_views_look_at_the_centre_from_the_sphere() {
+        let centre = Vec3::new(0.2, -0.1, 0.4);
+        for upper in [false, true] {
+            let poses = sample_views(64, centre, 2.5, 9, upper);
+            assert_eq!(poses, sample_views(64, centre, 2.5, 9, upper));
+            assert_ne!(poses, sample_views(64, centre, 2.5, 10, upper));
+            let mut below = 0;
+            for pose in &poses {
+                let cam = Camera {
+                    camera_to_world: *pose,
+                    intrinsics: Intrinsics::from_fov(16, 12, 1.0, None),
+                };
+                assert!(((cam.position() - centre).length() - 2.5).abs() < 1e-4);
+                let (px, depth) = cam.project(centre).unwrap();
+                assert!((px - glam::Vec2::new(8.0, 6.0)).length() < 1e-3, "{px}");
+                assert!((depth - 2.5).abs() < 1e-4);
+                below += usize::from(cam.position().z < centre.z);
+            }
+            assert_eq!(below == 0, upper, "{below} of 64 below the centre");
+        }
     }
 }
