@@ -483,3 +483,51 @@ fn textures_are_sampled_with_gltf_orientation() {
         assert_eq!(got[3], 255);
     }
 }
+
+#[test]
+fn ground_slab_reaching_behind_the_camera_is_not_clipped() {
+    let ctx = context();
+    // A 100 m ground slab whose vertices lie far ahead of and behind the camera: the near plane must follow
+    // the visible geometry, not the nearest vertex in front (about 45 m away here).
+    let slab = Aabb {
+        centre: Vec3::new(0.0, 0.0, -0.05),
+        size: Vec3::new(100.0, 100.0, 0.1),
+        part: 0,
+    };
+    let camera = Camera {
+        camera_to_world: look_at(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 4.0, 0.0), Vec3::Z),
+        intrinsics: intrinsics(),
+    };
+    let view = render(&ctx, &[slab.mesh()], &camera);
+    let (err, covered, expected) = check_against_reference(&view, &camera, &[slab]);
+    eprintln!(
+        "ground slab: max depth error {:.4} mm, {covered} of {expected} px",
+        err * 1e3
+    );
+    assert!(err < 0.5e-3, "max depth error {err} m");
+    // The bottom row sees the ground about 1.3 m away.
+    let bottom = ((H - 1) * W + W / 2) as usize;
+    assert!(view.depth.millimetres[bottom] > 0 && view.depth.millimetres[bottom] < 2000);
+}
+
+#[test]
+fn depth_beyond_the_u16_range_is_clamped() {
+    let ctx = context();
+    let far_box = Aabb {
+        centre: Vec3::new(0.0, 0.0, -75.0),
+        size: Vec3::new(12.0, 12.0, 10.0),
+        part: 0,
+    };
+    let camera = Camera {
+        camera_to_world: look_at(Vec3::ZERO, Vec3::new(0.0, 0.0, -1.0), Vec3::Y),
+        intrinsics: intrinsics(),
+    };
+    let view = render(&ctx, &[far_box.mesh()], &camera);
+    let centre = ((H / 2) * W + W / 2) as usize;
+    assert!(
+        (view.depth_metres[centre] - 70.0).abs() < 1e-3,
+        "{}",
+        view.depth_metres[centre]
+    );
+    assert_eq!(view.depth.millimetres[centre], u16::MAX);
+}

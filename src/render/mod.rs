@@ -579,24 +579,31 @@ fn vertices_of(i: usize, m: &RenderMesh) -> GpuResult<Vec<Vertex>> {
 }
 
 /// Near and far planes (positive view depths) enclosing every finite vertex in front of the camera, with a
-/// margin; geometry behind the camera is clipped by the near plane.
+/// margin. When some vertex lies at or behind the camera plane, triangles through it can be visible arbitrarily
+/// close, so near drops to `far · 1e-6` (reversed z keeps that ratio well resolved); what is closer is clipped.
 fn near_far(meshes: &[PartMesh], world_to_camera: &Mat4) -> (f32, f32) {
     let mut lo = f32::INFINITY;
     let mut hi = 0.0f32;
+    let mut behind = false;
     for p in meshes.iter().flat_map(|m| m.mesh.positions.iter()) {
         let z = -world_to_camera.transform_point3(*p).z;
-        if z.is_finite() && z > 0.0 {
+        if !z.is_finite() {
+            continue;
+        }
+        if z > 0.0 {
             lo = lo.min(z);
             hi = hi.max(z);
+        } else {
+            behind = true;
         }
     }
     if hi <= 0.0 {
         return (0.01, 100.0);
     }
-    let far = hi * 1.01 + 1e-3;
-    // Keep near/far ≤ 1e6 so the reversed-z mapping stays well-conditioned.
-    let near = (lo * 0.99).clamp(far * 1e-6, far * 0.5);
-    (near, far)
+    // Capped so that far − near and near · far stay finite in f32.
+    let far = (hi * 1.01 + 1e-3).min(1e12);
+    let near = if behind { far * 1e-6 } else { lo * 0.99 };
+    (near.clamp(far * 1e-6, far * 0.5), far)
 }
 
 /// Uploads an 8-bit RGBA image as an sRGB texture (sampling returns linear values), shrinking it by an integer
