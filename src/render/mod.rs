@@ -296,7 +296,7 @@ impl GtRenderer {
     }
 
     /// Renders `meshes` (world space) through `camera`, whose intrinsics must match the renderer's size.
-    /// Textures are uploaded once per distinct image per call. Meshes with out-of-range indices, or too big
+    /// Textures are uploaded once per distinct image per call; a texture on a mesh without uvs is ignored. Meshes with out-of-range indices, or too big
     /// for one GPU buffer, are errors; non-finite vertices are ignored when fitting near/far.
     pub async fn render_view(
         &self,
