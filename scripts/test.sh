@@ -28,7 +28,9 @@ step "native tests (WGPU_BACKEND=$WGPU_BACKEND)"
 cargo test --all-targets
 
 step "wasm build of the page"
-web/build.sh
+# The dev profile shares its build with the browser tests below (a release build would compile
+# wgpu for wasm a second time); `web/build.sh` alone builds release for people.
+ARTMESH_WEB_PROFILE=dev web/build.sh
 
 step "browser tests (wasm-bindgen-test in headless Chromium, WebGPU)"
 export CHROMEDRIVER=${CHROMEDRIVER:-/usr/bin/chromedriver}
