@@ -146,17 +146,7 @@ impl Dataset {
             .max()
             .unwrap_or(0);
         let num_parts = implied_num_parts(gt_joints.as_deref(), max_id, max_meshes);
-        for (state, m) in State::ALL.iter().zip(&meshes) {
-            if let Some(m) = m {
-                check_mesh_count(
-                    *state,
-                    m.movable.len(),
-                    num_parts,
-                    gt_joints.is_some(),
-                    &mut errs,
-                );
-            }
-        }
+        check_mesh_counts(&meshes, num_parts, gt_joints.is_some(), &mut errs);
         errs.finish(Dataset {
             views,
             num_parts,
@@ -453,11 +443,7 @@ impl GroundTruth {
             .and_then(|b| gt::parse_trans(b, &mut errs));
         let meshes = State::ALL.map(|s| read_gt_meshes(files, s, &mut errs));
         if let Some(joints) = &joints {
-            for (state, m) in State::ALL.iter().zip(&meshes) {
-                if let Some(m) = m {
-                    check_mesh_count(*state, m.movable.len(), joints.len() + 1, true, &mut errs);
-                }
-            }
+            check_mesh_counts(&meshes, joints.len() + 1, true, &mut errs);
         }
         if joints.is_none() && meshes.iter().all(Option::is_none) {
             errs.push(DataError::file(
@@ -546,6 +532,20 @@ fn read_gt_meshes(files: &FileSet, state: State, errs: &mut Errors) -> Option<Gt
 }
 
 /// A state's GT meshes must cover every movable part, and no more.
+/// Each state's GT meshes must cover exactly the `num_parts - 1` movable parts.
+fn check_mesh_counts(
+    meshes: &[Option<GtMeshes>; 2],
+    num_parts: usize,
+    from_joints: bool,
+    errs: &mut Errors,
+) {
+    for (state, m) in State::ALL.into_iter().zip(meshes) {
+        if let Some(m) = m {
+            check_mesh_count(state, m.movable.len(), num_parts, from_joints, errs);
+        }
+    }
+}
+
 fn check_mesh_count(
     state: State,
     count: usize,
