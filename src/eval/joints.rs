@@ -224,19 +224,14 @@ pub fn match_joints_using(
     gt: &[GtJoint],
     solver: Solver,
 ) -> Result<JointMatching, EvalError> {
-    for (index, j) in pred.iter().enumerate() {
-        validate_joint(j).map_err(|reason| EvalError::InvalidJoint {
-            side: "predicted",
-            index,
-            reason,
-        })?;
-    }
-    for (index, j) in gt.iter().enumerate() {
-        validate_joint(j).map_err(|reason| EvalError::InvalidJoint {
-            side: "ground-truth",
-            index,
-            reason,
-        })?;
+    for (side, joints) in [("predicted", pred), ("ground-truth", gt)] {
+        for (index, j) in joints.iter().enumerate() {
+            validate_joint(j).map_err(|reason| EvalError::InvalidJoint {
+                side,
+                index,
+                reason,
+            })?;
+        }
     }
     let metrics: Vec<Vec<JointPairMetrics>> = pred
         .iter()
