@@ -56,7 +56,8 @@ pub fn inspect_dataset(
         .collect();
     let value = match Dataset::from_files(&files) {
         Ok(dataset) => {
-            serde_json::json!({ "ok": true, "summary": dataset.summary(), "text": dataset.summary().to_string() })
+            let summary = dataset.summary();
+            serde_json::json!({ "ok": true, "text": summary.to_string(), "summary": summary })
         }
         Err(problems) => serde_json::json!({
             "ok": false,
