@@ -5,7 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
-use crate::gpu::{AdapterReport, GpuContext, GpuResult, RadixSort};
+use crate::gpu::{AdapterReport, GpuContext, GpuResult, RadixSort, key_mask};
 use crate::rng::Rng;
 
 /// Throughput of one sort size.
@@ -38,11 +38,7 @@ pub fn sort(
     let mut results = Vec::new();
     for &n in sizes {
         let mut rng = Rng::new(u64::from(n));
-        let mask = if key_bits >= 32 {
-            u32::MAX
-        } else {
-            (1 << key_bits) - 1
-        };
+        let mask = key_mask(key_bits);
         let keys: Vec<u32> = (0..n).map(|_| rng.next_u32() & mask).collect();
         let values: Vec<u32> = (0..n).collect();
         let sorter = RadixSort::new(ctx, n)?;

@@ -17,7 +17,7 @@ pub mod selftest;
 pub use buffers::binding_chunks;
 pub use context::{AdapterReport, GpuContext, GpuError};
 pub use kernel::{Binding, KernelFamily};
-pub use radix_sort::RadixSort;
+pub use radix_sort::{RadixSort, key_mask};
 pub use scan::PrefixSum;
 
 /// Result type of everything that touches the GPU.

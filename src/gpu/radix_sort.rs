@@ -29,6 +29,11 @@ struct SortParams {
 }
 const _: () = assert!(size_of::<SortParams>() == 16);
 
+/// The bits a key may use when sorted with `key_bits` significant bits (1..=32).
+pub fn key_mask(key_bits: u32) -> u32 {
+    u32::MAX >> (32 - key_bits.clamp(1, 32))
+}
+
 /// A GPU radix sorter for up to `capacity` (key, value) pairs.
 pub struct RadixSort {
     count_digits: wgpu::ComputePipeline,

@@ -4,7 +4,7 @@
 
 use serde::Serialize;
 
-use super::{GpuContext, GpuResult, PrefixSum, RadixSort};
+use super::{GpuContext, GpuResult, PrefixSum, RadixSort, key_mask};
 use crate::rng::Rng;
 
 /// Sizes the self-test covers by default: tiny, block edges, non-powers of two, ~1M.
@@ -88,11 +88,7 @@ pub async fn check_radix_sort(
     seed: u64,
 ) -> GpuResult<PrimitiveCheck> {
     let mut rng = Rng::new(seed);
-    let mask = if key_bits >= 32 {
-        u32::MAX
-    } else {
-        (1u32 << key_bits) - 1
-    };
+    let mask = key_mask(key_bits);
     let mut keys: Vec<u32> = Vec::with_capacity(n as usize);
     for i in 0..n as usize {
         let key = if i > 0 && rng.below(2) == 0 {
