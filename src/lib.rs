@@ -11,6 +11,7 @@ pub mod gpu;
 pub mod object;
 pub mod render;
 pub mod rng;
+pub mod synth;
 
 #[cfg(not(target_arch = "wasm32"))]
 pub mod bench;
