@@ -120,6 +120,18 @@ impl RenderMesh {
     }
 }
 
+/// Axis-aligned bounds of the finite vertices of `meshes`; `None` when there are none.
+pub fn mesh_bounds<'a>(meshes: impl IntoIterator<Item = &'a RenderMesh>) -> Option<(Vec3, Vec3)> {
+    meshes
+        .into_iter()
+        .flat_map(|m| m.positions.iter())
+        .filter(|p| p.is_finite())
+        .fold(None, |acc, &p| match acc {
+            None => Some((p, p)),
+            Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
+        })
+}
+
 /// Shape of a visual or collision element.
 #[derive(Debug, Clone, PartialEq)]
 pub enum Geometry {

@@ -18,6 +18,10 @@
 //!
 //! The module is async and I/O-free, so it runs natively and in the browser.
 
+mod sheet;
+
+pub use sheet::{SheetEntry, contact_sheet, overview_camera};
+
 use std::collections::HashMap;
 use std::collections::hash_map::Entry;
 use std::sync::Arc;
@@ -697,6 +701,29 @@ pub fn sample_views(
             look_at(centre + dir * radius, centre, up)
         })
         .collect()
+}
+
+/// Axis-aligned bounds of the finite vertices of `meshes`; `None` when there are none.
+pub fn object_bounds(meshes: &[PartMesh]) -> Option<(Vec3, Vec3)> {
+    crate::object::mesh_bounds(meshes.iter().map(|m| &m.mesh))
+}
+
+/// Joint values for one state: every part's joint at `lower + f · (upper − lower)` of its range with `f` drawn
+/// uniformly from `fraction` (Articulate-100 draws the start state from [0.6, 0.8] and the end state from
+/// [0.2, 0.4]); every other joint, merged chain joints included, at its rest value. One value per joint.
+pub fn sample_state(obj: &ArticulatedObject, fraction: (f32, f32), rng: &mut Rng) -> Vec<f32> {
+    let parts = obj.parts();
+    let values: Vec<f32> = parts
+        .parts
+        .iter()
+        .map(|part| {
+            let f = fraction.0 + (fraction.1 - fraction.0) * rng.next_f32();
+            part.joint
+                .and_then(|j| obj.joints[j].range())
+                .map_or(0.0, |(lo, hi)| lo + f * (hi - lo))
+        })
+        .collect();
+    parts.configuration(obj, &values)
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@ use glam::{Affine3A, Quat, Vec2, Vec3};
 use super::texture::TILE_METRES;
 use crate::object::{
     ArticulatedObject, Geometry, Joint, JointKind, Limit, Link, Material, RenderMesh, Visual,
+    mesh_bounds,
 };
 
 /// Segments around round shapes.
@@ -181,17 +182,6 @@ pub fn torus(centre: Vec3, axis: Vec3, major: f32, minor: f32, material: &Materi
     m.transformed(&Affine3A::from_rotation_translation(z_to(axis), centre))
 }
 
-/// Axis-aligned bounds of a set of meshes, `None` when they hold no vertex.
-pub fn bounds<'a>(meshes: impl IntoIterator<Item = &'a RenderMesh>) -> Option<(Vec3, Vec3)> {
-    meshes
-        .into_iter()
-        .flat_map(|m| m.positions.iter())
-        .fold(None, |acc, &p| match acc {
-            None => Some((p, p)),
-            Some((lo, hi)) => Some((lo.min(p), hi.max(p))),
-        })
-}
-
 /// Assembles an [`ArticulatedObject`]: link 0 is the static base; every other link hangs on one joint.
 ///
 /// Geometry is given in the **object frame at the rest pose** (all joints at 0); the builder moves each
@@ -281,7 +271,7 @@ impl ObjectBuilder {
             }
             let to_link = self.link_poses[k].inverse();
             let local: Vec<RenderMesh> = meshes.iter().map(|m| m.transformed(&to_link)).collect();
-            if let Some((lo, hi)) = bounds(&local) {
+            if let Some((lo, hi)) = mesh_bounds(&local) {
                 links[k].collisions.push(Visual {
                     name: None,
                     origin: Affine3A::from_translation((lo + hi) * 0.5),
