@@ -10,6 +10,7 @@ use super::npy;
 use super::paths;
 use super::ply::{PlyFormat, TriMesh};
 use super::transforms::{self, FrameSpec};
+use super::writer::DatasetWriter;
 use super::{FileSet, GT_TRANS_PATH, Split, State, transforms_file_name};
 
 /// One view: camera, colour, and optional depth and part ids, all of the same size.
@@ -74,7 +75,7 @@ pub struct WriteOptions {
 
 /// Part count implied by the ground-truth joints, the largest part id seen and the GT mesh count: one rule for
 /// reader and writer. With `gt/trans.json` it is 1 + joints; otherwise 1 + the largest id or mesh index.
-fn implied_num_parts(
+pub(crate) fn implied_num_parts(
     joints: Option<&[GtJoint]>,
     max_id: Option<i16>,
     max_movable_meshes: usize,
@@ -163,51 +164,29 @@ impl Dataset {
     /// Writes the dataset with the given options. Fails on data the reader would reject or that cannot be
     /// encoded (empty view sets, mismatched sizes, duplicate frame names, inconsistent part count).
     pub fn to_files_with(&self, options: &WriteOptions) -> Result<FileSet, DataError> {
+        let mut writer = DatasetWriter::new(*options);
         let mut out = FileSet::new();
-        for state in State::ALL {
-            if self.views(state, Split::Train).is_none() {
-                return Err(DataError::file(
-                    transforms_file_name(Split::Train, state),
-                    "cannot write: the train views of both states are required",
-                ));
-            }
-        }
+        let mut seen = BTreeSet::new();
         for view in &self.views {
             let file = transforms_file_name(view.split, view.state);
-            if out.contains_key(&file) {
+            if !seen.insert((view.state, view.split)) {
                 return Err(DataError::file(
                     file,
                     "cannot write: two view sets for the same state and split",
                 ));
             }
-            write_view_set(view, options, &mut out)?;
-            out.insert(file, transforms::write(view));
+            if view.frames.is_empty() {
+                return Err(DataError::field(
+                    &file,
+                    "frames",
+                    "cannot write an empty view set: expected at least one frame",
+                ));
+            }
+            for frame in &view.frames {
+                out.extend(writer.add_frame(view.state, view.split, frame)?);
+            }
         }
-        let max_id = self
-            .views
-            .iter()
-            .flat_map(|v| &v.frames)
-            .filter_map(|f| f.parts.as_ref()?.max_id())
-            .max();
-        let max_meshes = self
-            .gt_meshes
-            .iter()
-            .flatten()
-            .map(|m| m.movable.len())
-            .max()
-            .unwrap_or(0);
-        let implied = implied_num_parts(self.gt_joints.as_deref(), max_id, max_meshes);
-        if implied != self.num_parts {
-            return Err(DataError::field(
-                GT_TRANS_PATH,
-                "num_parts",
-                format!(
-                    "cannot write: num_parts is {}, but the joints, part ids and GT meshes imply {implied}",
-                    self.num_parts
-                ),
-            ));
-        }
-        write_ground_truth(self.gt_joints.as_deref(), &self.gt_meshes, &mut out);
+        out.extend(writer.finish(self.num_parts, self.gt_joints.as_deref(), &self.gt_meshes)?);
         Ok(out)
     }
 
@@ -274,7 +253,14 @@ fn read_view_set(
     })
 }
 
-fn size_error(file: &str, what: &str, w: u32, h: u32, found_w: u32, found_h: u32) -> DataError {
+pub(crate) fn size_error(
+    file: &str,
+    what: &str,
+    w: u32,
+    h: u32,
+    found_w: u32,
+    found_h: u32,
+) -> DataError {
     DataError::field(
         file,
         "size",
@@ -462,7 +448,7 @@ impl GroundTruth {
     }
 }
 
-fn write_ground_truth(
+pub(crate) fn write_ground_truth(
     joints: Option<&[GtJoint]>,
     meshes: &[Option<GtMeshes>; 2],
     out: &mut FileSet,
@@ -571,122 +557,4 @@ fn check_mesh_count(
             format!("unexpected: {why}, so there is no movable part {i}"),
         ));
     }
-}
-
-/// Checks a view set the writer is about to write, and encodes its images into `out`.
-fn write_view_set(
-    view: &ViewSet,
-    options: &WriteOptions,
-    out: &mut FileSet,
-) -> Result<(), DataError> {
-    let file = transforms_file_name(view.split, view.state);
-    let first = view.frames.first().ok_or_else(|| {
-        DataError::field(
-            &file,
-            "frames",
-            "cannot write an empty view set: expected at least one frame",
-        )
-    })?;
-    let mut names = BTreeSet::new();
-    for (i, frame) in view.frames.iter().enumerate() {
-        let field = format!("frames[{i}]");
-        let bad_name = frame.name.is_empty()
-            || frame.name.contains(['/', '\\'])
-            || frame.name == "."
-            || frame.name == ".."
-            || frame.name.to_ascii_lowercase().ends_with(".png");
-        if bad_name || !names.insert(frame.name.as_str()) {
-            return Err(DataError::field(
-                &file,
-                format!("{field}.name"),
-                format!(
-                    "cannot write: frame name \"{}\" is empty, a duplicate, or not a plain file stem",
-                    frame.name
-                ),
-            ));
-        }
-        let rgba_path = transforms::frame_path(view, "rgba", &frame.name, ".png");
-        let k = &frame.camera.intrinsics;
-        if (frame.rgba.width, frame.rgba.height) != (first.rgba.width, first.rgba.height)
-            || (k.width, k.height) != (frame.rgba.width, frame.rgba.height)
-        {
-            return Err(size_error(
-                &rgba_path,
-                "the first image and the intrinsics",
-                first.rgba.width,
-                first.rgba.height,
-                frame.rgba.width,
-                frame.rgba.height,
-            ));
-        }
-        if frame.depth.is_some() != first.depth.is_some()
-            || frame.parts.is_some() != first.parts.is_some()
-        {
-            return Err(DataError::field(
-                &file,
-                field,
-                "cannot write: depth and semantic maps must be present for all frames of a split or for none",
-            ));
-        }
-        out.insert(
-            rgba_path.clone(),
-            image_io::encode_png(
-                &rgba_path,
-                frame.rgba.width,
-                frame.rgba.height,
-                image_io::PngPixels::Rgba8(&frame.rgba.pixels),
-            )?,
-        );
-        // Depth and part maps must match their colour frame pixel for pixel.
-        let same_size = |path: &str, width: u32, height: u32| -> Result<(), DataError> {
-            if (width, height) == (frame.rgba.width, frame.rgba.height) {
-                return Ok(());
-            }
-            let expected = format!("the size of {rgba_path}");
-            Err(size_error(
-                path,
-                &expected,
-                frame.rgba.width,
-                frame.rgba.height,
-                width,
-                height,
-            ))
-        };
-        if let Some(d) = &frame.depth {
-            let path = transforms::frame_path(view, "depth", &frame.name, ".png");
-            same_size(&path, d.width, d.height)?;
-            let png = image_io::encode_png(
-                &path,
-                d.width,
-                d.height,
-                image_io::PngPixels::Gray16(&d.millimetres),
-            )?;
-            out.insert(path, png);
-        }
-        if let Some(m) = &frame.parts {
-            let ext = match options.semantic {
-                SemanticFormat::Png => ".png",
-                SemanticFormat::Npy => ".npy",
-            };
-            let path = transforms::frame_path(view, "semantic", &frame.name, ext);
-            same_size(&path, m.width, m.height)?;
-            let expected_len = u64::from(m.width) * u64::from(m.height);
-            if m.ids.len() as u64 != expected_len || m.ids.iter().any(|&id| id < -1) {
-                return Err(DataError::field(
-                    &path,
-                    "part id",
-                    format!(
-                        "cannot write: expected {expected_len} ids of at least -1, found {} ids",
-                        m.ids.len()
-                    ),
-                ));
-            }
-            let bytes = match options.semantic {
-                SemanticFormat::Png => image_io::encode_parts_png(&path, m)?,
-                SemanticFormat::Npy => npy::encode_parts_npy(m),
-            };
-            out.insert(path, bytes);
-        }
-    }
-    Ok(())
 }

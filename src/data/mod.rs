@@ -29,6 +29,7 @@ mod paths;
 mod ply;
 mod summary;
 mod transforms;
+mod writer;
 
 use std::collections::BTreeMap;
 
@@ -43,6 +44,7 @@ pub use npy::encode_npy;
 pub use paths::rebase_on_dataset_root;
 pub use ply::{PlyFormat, TriMesh};
 pub use summary::{Summary, ViewSummary};
+pub use writer::DatasetWriter;
 
 /// A dataset as bytes: relative path (`'/'` separators, e.g. `start/train/rgba/0000.png`) → file contents.
 pub type FileSet = BTreeMap<String, Vec<u8>>;

@@ -7,11 +7,12 @@
 use glam::{DMat3, DVec3, Mat4};
 use serde_json::{Map, Value, json};
 
-use super::camera::Intrinsics;
-use super::dataset::{Frame, ViewSet};
+use super::camera::{Camera, Intrinsics};
+use super::dataset::Frame;
 use super::error::{DataError, Errors};
 use super::json::{self, Json, f32_array, f32_value, optional};
 use super::paths;
+use super::{Split, State};
 
 /// Tolerance of the rigidity checks on `transform_matrix`.
 const RIGID_TOLERANCE: f64 = 1e-3;
@@ -262,12 +263,26 @@ pub(crate) fn parse(file: &str, bytes: &[u8], errs: &mut Errors) -> Option<Trans
 }
 
 /// Dataset-relative path of a frame's image of `kind` (`rgba`, `depth`, `semantic`) with extension `ext`.
-pub(crate) fn frame_path(view: &ViewSet, kind: &str, name: &str, ext: &str) -> String {
-    format!(
-        "{}/{}/{kind}/{name}{ext}",
-        view.state.name(),
-        view.split.name()
-    )
+pub(crate) fn frame_path(state: State, split: Split, kind: &str, name: &str, ext: &str) -> String {
+    format!("{}/{}/{kind}/{name}{ext}", state.name(), split.name())
+}
+
+/// What the transforms file records of a frame: its name, camera and time (not its images).
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FrameMeta {
+    pub(crate) name: String,
+    pub(crate) camera: Camera,
+    pub(crate) time: f32,
+}
+
+impl FrameMeta {
+    pub(crate) fn of(frame: &Frame) -> FrameMeta {
+        FrameMeta {
+            name: frame.name.clone(),
+            camera: frame.camera,
+            time: frame.time,
+        }
+    }
 }
 
 fn intrinsics_fields(k: &Intrinsics) -> [(&'static str, Value); 6] {
@@ -281,12 +296,12 @@ fn intrinsics_fields(k: &Intrinsics) -> [(&'static str, Value); 6] {
     ]
 }
 
-fn frame_json(view: &ViewSet, frame: &Frame, base: &Intrinsics) -> Value {
+fn frame_json(state: State, split: Split, frame: &FrameMeta, base: &Intrinsics) -> Value {
     let c = frame.camera.camera_to_world.transpose().to_cols_array_2d(); // rows of the matrix
     let mut obj = Map::new();
     obj.insert(
         "file_path".into(),
-        json!(frame_path(view, "rgba", &frame.name, ".png")),
+        json!(frame_path(state, split, "rgba", &frame.name, ".png")),
     );
     obj.insert(
         "transform_matrix".into(),
@@ -306,8 +321,8 @@ fn frame_json(view: &ViewSet, frame: &Frame, base: &Intrinsics) -> Value {
 }
 
 /// Writes a view set's transforms file. The view set must be non-empty (checked by the caller).
-pub(crate) fn write(view: &ViewSet) -> Vec<u8> {
-    let Some(first) = view.frames.first() else {
+pub(crate) fn write(state: State, split: Split, frames: &[FrameMeta]) -> Vec<u8> {
+    let Some(first) = frames.first() else {
         return Vec::new();
     };
     let base = first.camera.intrinsics;
@@ -320,9 +335,9 @@ pub(crate) fn write(view: &ViewSet) -> Vec<u8> {
     obj.insert(
         "frames".into(),
         Value::Array(
-            view.frames
+            frames
                 .iter()
-                .map(|f| frame_json(view, f, &base))
+                .map(|f| frame_json(state, split, f, &base))
                 .collect(),
         ),
     );
