@@ -32,6 +32,7 @@ mod mesh_io;
 mod parts;
 mod primitives;
 mod urdf;
+mod urdf_write;
 
 use std::sync::Arc;
 
@@ -42,6 +43,7 @@ use crate::data::{DataError, FileSet, RgbaImage};
 pub use mesh_io::{MeshFormat, load_mesh};
 pub use parts::{MERGE_PRISMATIC_SPAN, MERGE_REVOLUTE_SPAN, Part, Parts, is_merged_chain_joint};
 pub use primitives::{box_mesh, cylinder_mesh, sphere_mesh};
+pub use urdf_write::write_urdf;
 
 /// Sampling range (radians) for continuous joints, which have no limits: one full turn centred on the rest pose.
 pub const CONTINUOUS_RANGE: (f32, f32) = (-std::f32::consts::PI, std::f32::consts::PI);

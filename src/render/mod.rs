@@ -18,8 +18,13 @@
 //!
 //! The module is async and I/O-free, so it runs natively and in the browser.
 
+mod dataset;
 mod sheet;
 
+pub use dataset::{
+    CaptureTruth, DatasetRenderError, MIN_OBJECT_SIZE, ObjectProblem, RenderProgress, RenderSpec,
+    RenderedDataset, capture_truth, render_dataset,
+};
 pub use sheet::{SheetEntry, contact_sheet, overview_camera};
 
 use std::collections::HashMap;

@@ -12,7 +12,10 @@
 
 pub mod builder;
 mod categories;
+mod suite;
 pub mod texture;
+
+pub use suite::{FULL_BUCKETS, SuiteEntry, suite_plan};
 
 use std::ops::RangeInclusive;
 

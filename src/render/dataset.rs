@@ -1,0 +1,391 @@
+//! Two-state datasets from an articulated object: the Articulate-100 recipe.
+//!
+//! [`render_dataset`] draws a start state from `[0.6, 0.8]` and an end state from `[0.2, 0.4]` of every part's
+//! joint range (normalised to [0, 1]), samples cameras on the upper hemisphere (or the whole sphere) around the
+//! object, renders RGBA, depth and part maps for the train and test views of both states, and writes the
+//! dataset layout of `data` with `gt/trans.json` and per-part GT meshes of both states. Frames are encoded and
+//! handed to a sink as they are rendered, so memory stays at one frame whatever the view count.
+//!
+//! Ground truth (DESIGN.md §2): one joint per movable part in part order, axis point `o` and direction `d` in
+//! world coordinates, `l` / `r` the joint values at start / end (degrees for revolute and continuous joints,
+//! metres for prismatic ones). Objects the part model cannot describe are refused with a clear
+//! [`ObjectProblem`]: nothing moves, a movable part hanging on another movable part, a part without surface,
+//! an object smaller than [`MIN_OBJECT_SIZE`], a joint whose range is empty.
+
+use glam::{Affine3A, Vec3};
+
+use super::{
+    GtRenderer, PartMesh, RenderedView, object_bounds, posed_part_meshes, sample_state,
+    sample_views,
+};
+use crate::data::{
+    Camera, DataError, DatasetWriter, FileSet, Frame, GtJoint, GtMeshes, JointKind as GtKind,
+    Split, State, TriMesh, WriteOptions,
+};
+use crate::gpu::{GpuContext, GpuError};
+use crate::object::{ArticulatedObject, JointKind};
+use crate::rng::Rng;
+
+/// Objects whose bounding box diagonal is below this (metres) are refused as having no volume to image.
+pub const MIN_OBJECT_SIZE: f32 = 1e-3;
+
+/// How to render a dataset. [`Default`] is the paper's Articulate-100 setting.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RenderSpec {
+    /// Image width in pixels.
+    pub width: u32,
+    /// Image height in pixels.
+    pub height: u32,
+    /// Train views per state.
+    pub train_views: usize,
+    /// Test views per state (0 writes no test split).
+    pub test_views: usize,
+    /// Horizontal field of view, radians.
+    pub fov_x: f32,
+    /// Normalised joint-range interval the start state is drawn from.
+    pub start_range: (f32, f32),
+    /// Normalised joint-range interval the end state is drawn from.
+    pub end_range: (f32, f32),
+    /// Cameras on the upper hemisphere (above the object's centre) instead of the whole sphere.
+    pub upper_hemisphere: bool,
+    /// Seed of the state draw and the camera positions.
+    pub seed: u64,
+}
+
+impl Default for RenderSpec {
+    fn default() -> Self {
+        RenderSpec {
+            width: 800,
+            height: 800,
+            train_views: 100,
+            test_views: 20,
+            // Blender's default 50 mm lens on a 36 mm sensor, as in the NeRF-synthetic family of datasets.
+            fov_x: 0.691_111,
+            start_range: (0.6, 0.8),
+            end_range: (0.2, 0.4),
+            upper_hemisphere: true,
+            seed: 0,
+        }
+    }
+}
+
+/// Why an object cannot become a dataset.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ObjectProblem {
+    /// No movable joint survives the part view.
+    #[error("object '{0}' has no movable joint: there is no articulation to capture")]
+    NothingMoves(String),
+    /// A movable part hangs on another movable part.
+    #[error(
+        "joint '{joint}' moves part {part}, which hangs on movable part {parent}: ArtMesh datasets need every \
+         movable part to move relative to the static base (fix the other joint or make one of them fixed)"
+    )]
+    NestedPart {
+        /// The joint of the nested part.
+        joint: String,
+        /// The nested part.
+        part: usize,
+        /// The movable part it hangs on.
+        parent: usize,
+    },
+    /// A part with no triangle of positive area.
+    #[error("part {part} (links {links}) has no visible surface: give its links visual geometry")]
+    NoSurface {
+        /// The part.
+        part: usize,
+        /// Its link names, comma-separated.
+        links: String,
+    },
+    /// The object is (nearly) a point.
+    #[error(
+        "object '{name}' has zero volume: its bounding box is {size:?} m (needs a diagonal of at least {min} m)"
+    )]
+    ZeroVolume {
+        /// Object name.
+        name: String,
+        /// Bounding-box size.
+        size: [f32; 3],
+        /// [`MIN_OBJECT_SIZE`].
+        min: f32,
+    },
+    /// A joint whose lower and upper limits coincide: both states would be the same.
+    #[error(
+        "joint '{joint}' has an empty range [{lower}, {upper}]: start and end states would be identical"
+    )]
+    EmptyRange {
+        /// Joint name.
+        joint: String,
+        /// Lower limit.
+        lower: f32,
+        /// Upper limit.
+        upper: f32,
+    },
+    /// A bad render specification.
+    #[error("{0}")]
+    BadSpec(String),
+}
+
+/// Everything that can stop [`render_dataset`].
+#[derive(Debug, thiserror::Error)]
+pub enum DatasetRenderError {
+    /// The object cannot be captured as a two-state dataset.
+    #[error(transparent)]
+    Object(#[from] ObjectProblem),
+    /// The GPU failed.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// Encoding or the sink failed.
+    #[error(transparent)]
+    Data(#[from] DataError),
+}
+
+/// Ground truth of a two-state capture.
+#[derive(Debug, Clone, PartialEq)]
+pub struct CaptureTruth {
+    /// Joint values (one per joint of the object) at start and end.
+    pub states: [Vec<f32>; 2],
+    /// One joint per movable part, in part order, in `trans.json` units.
+    pub joints: Vec<GtJoint>,
+    /// Part meshes (world frame) at start and end.
+    pub meshes: [GtMeshes; 2],
+}
+
+/// Checks that `obj` fits the part model (see the module docs) and returns its ground truth at `states`.
+pub fn capture_truth(
+    obj: &ArticulatedObject,
+    states: [Vec<f32>; 2],
+) -> Result<CaptureTruth, ObjectProblem> {
+    let parts = obj.parts();
+    if parts.movable_count() == 0 {
+        return Err(ObjectProblem::NothingMoves(obj.name.clone()));
+    }
+    let start_poses = obj.forward_kinematics(&states[0]);
+    let mut joints = Vec::with_capacity(parts.movable_count());
+    for (k, part) in parts.parts.iter().enumerate().skip(1) {
+        let Some(j) = part.joint else { continue };
+        let joint = &obj.joints[j];
+        let parent = parts.link_part.get(joint.parent).copied().unwrap_or(0);
+        if parent != 0 {
+            return Err(ObjectProblem::NestedPart {
+                joint: joint.name.clone(),
+                part: k,
+                parent,
+            });
+        }
+        let (lower, upper) = joint.range().unwrap_or((0.0, 0.0));
+        if !(upper > lower) {
+            return Err(ObjectProblem::EmptyRange {
+                joint: joint.name.clone(),
+                lower,
+                upper,
+            });
+        }
+        // The base does not move, so the joint frame is the same at both states.
+        let frame: Affine3A = start_poses[joint.parent] * joint.origin;
+        let value = |s: usize| states[s].get(j).copied().unwrap_or(0.0);
+        let (kind, scale) = match joint.kind {
+            JointKind::Prismatic => (GtKind::Prismatic, 1.0),
+            _ => (GtKind::Revolute, 180.0 / std::f32::consts::PI),
+        };
+        joints.push(GtJoint {
+            kind,
+            origin: frame.translation.into(),
+            direction: (frame.matrix3 * joint.axis).normalize_or_zero(),
+            start: value(0) * scale,
+            end: value(1) * scale,
+        });
+    }
+    let meshes =
+        [0, 1].map(|s| part_meshes(&posed_part_meshes(obj, &states[s]), parts.parts.len()));
+    for (k, mesh) in meshes[0].iter().enumerate() {
+        if surface_area(mesh) <= 0.0 {
+            let links: Vec<&str> = parts.parts[k]
+                .links
+                .iter()
+                .map(|&l| obj.links[l].name.as_str())
+                .collect();
+            return Err(ObjectProblem::NoSurface {
+                part: k,
+                links: links.join(", "),
+            });
+        }
+    }
+    let [start, end] = meshes.map(|mut m| {
+        let static_part = m.remove(0);
+        GtMeshes {
+            static_part,
+            movable: m,
+        }
+    });
+    Ok(CaptureTruth {
+        states,
+        joints,
+        meshes: [start, end],
+    })
+}
+
+/// One merged triangle mesh per part.
+fn part_meshes(posed: &[PartMesh], count: usize) -> Vec<TriMesh> {
+    let mut out = vec![TriMesh::default(); count];
+    for m in posed {
+        let Some(target) = usize::try_from(m.part).ok().and_then(|k| out.get_mut(k)) else {
+            continue;
+        };
+        let base = target.positions.len() as u32;
+        target.positions.extend_from_slice(&m.mesh.positions);
+        target
+            .triangles
+            .extend(m.mesh.indices.iter().map(|t| t.map(|i| i + base)));
+    }
+    out
+}
+
+fn surface_area(mesh: &TriMesh) -> f64 {
+    mesh.triangles
+        .iter()
+        .filter_map(|t| {
+            let p = t.map(|i| mesh.positions.get(i as usize).copied());
+            let [Some(a), Some(b), Some(c)] = p else {
+                return None;
+            };
+            let area = f64::from((b - a).cross(c - a).length()) * 0.5;
+            area.is_finite().then_some(area)
+        })
+        .sum()
+}
+
+/// What [`render_dataset`] produced.
+#[derive(Debug, Clone, PartialEq)]
+pub struct RenderedDataset {
+    /// Parts including the base.
+    pub num_parts: usize,
+    /// Ground truth of the capture.
+    pub truth: CaptureTruth,
+    /// Frames rendered (all states and splits).
+    pub frames: usize,
+}
+
+/// Progress of [`render_dataset`]: frames done out of the total.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct RenderProgress {
+    /// Frames rendered so far.
+    pub done: usize,
+    /// Frames to render.
+    pub total: usize,
+}
+
+/// Renders the two-state dataset of `obj` (see the module docs). Every batch of files — one frame's images,
+/// then the transforms files and ground truth — goes to `sink` as soon as it is ready; `progress` hears about
+/// every frame.
+pub async fn render_dataset(
+    ctx: &GpuContext,
+    obj: &ArticulatedObject,
+    spec: &RenderSpec,
+    sink: &mut dyn FnMut(FileSet) -> Result<(), DataError>,
+    progress: &mut dyn FnMut(RenderProgress),
+) -> Result<RenderedDataset, DatasetRenderError> {
+    check_spec(spec)?;
+    let mut rng = Rng::new(spec.seed);
+    let states = [
+        sample_state(obj, spec.start_range, &mut rng),
+        sample_state(obj, spec.end_range, &mut rng),
+    ];
+    let truth = capture_truth(obj, states)?;
+    let posed = truth.states.each_ref().map(|q| posed_part_meshes(obj, q));
+    let (lo, hi) = posed
+        .iter()
+        .filter_map(|m| object_bounds(m))
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), (a, b)| {
+            (l.min(a), h.max(b))
+        });
+    let size = hi - lo;
+    if !size.is_finite() || size.length() < MIN_OBJECT_SIZE {
+        return Err(ObjectProblem::ZeroVolume {
+            name: obj.name.clone(),
+            size: if size.is_finite() {
+                size.to_array()
+            } else {
+                [0.0; 3]
+            },
+            min: MIN_OBJECT_SIZE,
+        }
+        .into());
+    }
+    let renderer = GtRenderer::new(ctx, spec.width, spec.height)?;
+    let template = Camera::from_fov(
+        glam::Mat4::IDENTITY,
+        spec.width,
+        spec.height,
+        spec.fov_x,
+        None,
+    );
+    let half_fov = 0.5 * template.intrinsics.fov_x().min(template.intrinsics.fov_y());
+    let centre = (lo + hi) * 0.5;
+    // Far enough that the bounding sphere of both states fits every view, with a 10 % margin.
+    let distance = 0.5 * size.length() / half_fov.sin() * 1.1;
+    let mut writer = DatasetWriter::new(WriteOptions::default());
+    let total = 2 * (spec.train_views + spec.test_views);
+    let mut done = 0;
+    for state in State::ALL {
+        for (split, count) in [
+            (Split::Train, spec.train_views),
+            (Split::Test, spec.test_views),
+        ] {
+            let seed = rng.next_u64();
+            let poses = sample_views(count, centre, distance, seed, spec.upper_hemisphere);
+            for (i, pose) in poses.into_iter().enumerate() {
+                let camera = Camera {
+                    camera_to_world: pose,
+                    intrinsics: template.intrinsics,
+                };
+                let view = renderer
+                    .render_view(ctx, &posed[state.index()], &camera)
+                    .await?;
+                let frame = frame_of(view, format!("{i:04}"), camera, state.default_time());
+                sink(writer.add_frame(state, split, &frame)?)?;
+                done += 1;
+                progress(RenderProgress { done, total });
+            }
+        }
+    }
+    let [start, end] = truth.meshes.clone();
+    let num_parts = 1 + truth.joints.len();
+    sink(writer.finish(num_parts, Some(&truth.joints), &[Some(start), Some(end)])?)?;
+    Ok(RenderedDataset {
+        num_parts,
+        truth,
+        frames: total,
+    })
+}
+
+fn frame_of(view: RenderedView, name: String, camera: Camera, time: f32) -> Frame {
+    Frame {
+        name,
+        camera,
+        time,
+        rgba: view.rgba,
+        depth: Some(view.depth),
+        parts: Some(view.parts),
+    }
+}
+
+fn check_spec(spec: &RenderSpec) -> Result<(), ObjectProblem> {
+    let bad = |m: String| Err(ObjectProblem::BadSpec(m));
+    if spec.train_views == 0 {
+        return bad("at least one train view per state is needed".into());
+    }
+    if !(spec.fov_x > 0.0 && spec.fov_x < std::f32::consts::PI) {
+        return bad(format!(
+            "field of view {} rad is outside (0, π)",
+            spec.fov_x
+        ));
+    }
+    for (name, (a, b)) in [("start", spec.start_range), ("end", spec.end_range)] {
+        if !(0.0..=1.0).contains(&a) || !(0.0..=1.0).contains(&b) || a > b {
+            return bad(format!(
+                "{name} state range [{a}, {b}] must be an interval inside [0, 1] (fractions of each joint's range)"
+            ));
+        }
+    }
+    Ok(())
+}
