@@ -11,12 +11,15 @@ fn main() -> std::process::ExitCode {
 
 #[cfg(not(target_arch = "wasm32"))]
 mod cli {
+    mod capture;
+
     use std::path::{Path, PathBuf};
     use std::process::ExitCode;
 
     use artmesh::data::{self, Dataset, GroundTruth, State, fixture};
     use artmesh::eval;
     use artmesh::gpu::{GpuContext, selftest};
+    use artmesh::render::RenderSpec;
     use clap::{Parser, Subcommand};
 
     /// Articulated digital twins from multi-view RGB-D frames at two articulation states.
@@ -87,11 +90,114 @@ mod cli {
             #[arg(long, default_value_t = 10_000, value_parser = clap::value_parser!(u32).range(1..=1_000_000))]
             samples: u32,
         },
+        /// Generate a procedural object of one benchmark category and capture it as a two-state
+        /// dataset (ground truth included); the object itself goes to OUT/object/ as URDF + meshes.
+        Synth {
+            /// Category: a name of the paper's 16 (Box, Eyeglasses, Faucet, FoldingChair, Knife, Laptop,
+            /// Oven, Pen, Pliers, Refrigerator, StorageFurniture, Suitcase, Table, Toilet, TrashCan,
+            /// Window), any case, or an alias (storage, fridge, chair, bin, glasses, tap).
+            #[arg(long)]
+            category: String,
+            /// Movable parts (default: drawn from the category's range with the seed).
+            #[arg(long)]
+            parts: Option<usize>,
+            /// Seed of the shape, the states and the cameras.
+            #[arg(long, default_value_t = 0)]
+            seed: u64,
+            /// New folder to write.
+            #[arg(long)]
+            out: PathBuf,
+            /// Write only the object (URDF + meshes), no dataset.
+            #[arg(long)]
+            object_only: bool,
+            #[command(flatten)]
+            capture: CaptureArgs,
+        },
+        /// Capture a URDF object (with its meshes) as a two-state dataset with ground truth.
+        Render {
+            /// The URDF; relative mesh paths resolve against its folder, package:// paths against the
+            /// nearest enclosing folder with a package.xml.
+            urdf: PathBuf,
+            /// New folder to write.
+            #[arg(long)]
+            out: PathBuf,
+            /// Seed of the states and the cameras.
+            #[arg(long, default_value_t = 0)]
+            seed: u64,
+            #[command(flatten)]
+            capture: CaptureArgs,
+        },
+        /// Generate the benchmark suite: 100 procedural objects (16 categories, part-count buckets
+        /// 2 / 3 / 4-5 / 6+ in the paper's proportions 34 / 20 / 31 / 15), each captured as a
+        /// dataset, plus suite.json and a contact sheet.
+        Suite {
+            /// New folder to write.
+            #[arg(long)]
+            out: PathBuf,
+            /// The 16-object quick suite (one per category) at 64x64 with 6 train and 2 test views
+            /// per state, for CI; capture options still override.
+            #[arg(long)]
+            quick: bool,
+            #[command(flatten)]
+            capture: CaptureArgs,
+        },
         /// Benchmarks that print machine-readable JSON.
         Bench {
             #[command(subcommand)]
             which: Bench,
         },
+    }
+
+    /// How objects are captured (defaults: the paper's Articulate-100 setting).
+    #[derive(clap::Args)]
+    struct CaptureArgs {
+        /// Image width in pixels [default: 800; 64 with --quick].
+        #[arg(long, value_parser = clap::value_parser!(u32).range(8..=8192))]
+        width: Option<u32>,
+        /// Image height in pixels [default: 800; 64 with --quick].
+        #[arg(long, value_parser = clap::value_parser!(u32).range(8..=8192))]
+        height: Option<u32>,
+        /// Train views per state [default: 100; 6 with --quick].
+        #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+        train_views: Option<u32>,
+        /// Test views per state [default: 20; 2 with --quick].
+        #[arg(long, value_parser = clap::value_parser!(u32).range(0..=10_000))]
+        test_views: Option<u32>,
+        /// Horizontal field of view in degrees.
+        #[arg(long, default_value_t = 39.6)]
+        fov: f32,
+        /// Start state: interval of each joint's normalised range to draw from.
+        #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [0.6f32, 0.8])]
+        start_range: Vec<f32>,
+        /// End state: interval of each joint's normalised range to draw from.
+        #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [0.2f32, 0.4])]
+        end_range: Vec<f32>,
+        /// Cameras on the whole sphere instead of the upper hemisphere.
+        #[arg(long)]
+        sphere: bool,
+    }
+
+    impl CaptureArgs {
+        fn spec(&self, quick: bool, seed: u64) -> RenderSpec {
+            let (size, train, test) = if quick { (64, 6, 2) } else { (800, 100, 20) };
+            let pair = |v: &[f32]| {
+                (
+                    v.first().copied().unwrap_or(0.0),
+                    v.get(1).copied().unwrap_or(0.0),
+                )
+            };
+            RenderSpec {
+                width: self.width.unwrap_or(size),
+                height: self.height.unwrap_or(size),
+                train_views: self.train_views.map_or(train, |v| v as usize),
+                test_views: self.test_views.map_or(test, |v| v as usize),
+                fov_x: self.fov.to_radians(),
+                start_range: pair(&self.start_range),
+                end_range: pair(&self.end_range),
+                upper_hemisphere: !self.sphere,
+                seed,
+            }
+        }
     }
 
     #[derive(Subcommand)]
@@ -171,6 +277,52 @@ mod cli {
                 let id = id.unwrap_or_else(|| folder_name(&gt));
                 let report = evaluate(&pred, &gt, state, &id, &category, samples)?;
                 out!("{}", to_json(&report)?);
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Synth {
+                category,
+                parts,
+                seed,
+                out,
+                object_only,
+                capture,
+            } => {
+                let category = artmesh::synth::Category::parse(&category)?;
+                let params = artmesh::synth::SynthParams {
+                    category,
+                    movable_parts: parts,
+                    seed,
+                };
+                let object = artmesh::synth::generate(&params)?;
+                capture::fresh_folder(&out)?;
+                capture::write_object(&object, &out.join("object"))?;
+                if !object_only {
+                    let ctx = context()?;
+                    capture::dataset(&ctx, &object, &capture.spec(false, seed), &out)?;
+                }
+                out!("wrote {} to {}", object.name, out.display());
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Render {
+                urdf,
+                out,
+                seed,
+                capture,
+            } => {
+                let object = capture::read_urdf(&urdf)?;
+                capture::fresh_folder(&out)?;
+                let ctx = context()?;
+                capture::dataset(&ctx, &object, &capture.spec(false, seed), &out)?;
+                out!("wrote {} to {}", object.name, out.display());
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Suite {
+                out,
+                quick,
+                capture,
+            } => {
+                let ctx = context()?;
+                capture::suite(&ctx, &out, quick, &capture)?;
                 Ok(ExitCode::SUCCESS)
             }
             Command::Bench {

@@ -59,7 +59,8 @@ pub struct ObjectMetrics {
     pub part_motion_revolute: Option<f64>,
     /// Part Motion (m) over pairs with a prismatic GT joint.
     pub part_motion_prismatic: Option<f64>,
-    /// CD-s: Chamfer distance of the static part (`None` when evaluated without meshes).
+    /// CD-s: Chamfer distance of the static part (`None` when evaluated without meshes, or when the GT static
+    /// part has no triangles, e.g. a door captured without its frame).
     pub cd_s: Option<ChamferDistance>,
     /// CD-m: Chamfer distance averaged over matched movable parts.
     pub cd_m: Option<ChamferDistance>,
@@ -141,13 +142,16 @@ pub fn evaluate_object(
                 )));
             }
         }
-        cd_s = Some(chamfer_labelled(
-            &pred_meshes.static_part,
-            &gt_meshes.static_part,
-            "predicted static part",
-            "ground-truth static part",
-            &options.chamfer,
-        )?);
+        // An object without a static surface (a door captured without its frame) has no CD-s.
+        if !gt_meshes.static_part.triangles.is_empty() {
+            cd_s = Some(chamfer_labelled(
+                &pred_meshes.static_part,
+                &gt_meshes.static_part,
+                "predicted static part",
+                "ground-truth static part",
+                &options.chamfer,
+            )?);
+        }
         for p in pairs {
             let chamfer = chamfer_labelled(
                 &pred_meshes.movable[p.pred],

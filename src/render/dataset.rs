@@ -9,8 +9,9 @@
 //! Ground truth (DESIGN.md §2): one joint per movable part in part order, axis point `o` and direction `d` in
 //! world coordinates, `l` / `r` the joint values at start / end (degrees for revolute and continuous joints,
 //! metres for prismatic ones). Objects the part model cannot describe are refused with a clear
-//! [`ObjectProblem`]: nothing moves, a movable part hanging on another movable part, a part without surface,
-//! an object smaller than [`MIN_OBJECT_SIZE`], a joint whose range is empty.
+//! [`ObjectProblem`]: nothing moves, a movable part hanging on another movable part, a movable part without
+//! surface, an object smaller than [`MIN_OBJECT_SIZE`], a joint whose range is empty. A static base without
+//! surface is allowed (a door without its frame); its GT mesh is then empty and evaluation reports no CD-s.
 
 use glam::{Affine3A, Vec3};
 
@@ -88,7 +89,7 @@ pub enum ObjectProblem {
         /// The movable part it hangs on.
         parent: usize,
     },
-    /// A part with no triangle of positive area.
+    /// A movable part with no triangle of positive area.
     #[error("part {part} (links {links}) has no visible surface: give its links visual geometry")]
     NoSurface {
         /// The part.
@@ -197,7 +198,9 @@ pub fn capture_truth(
     }
     let meshes =
         [0, 1].map(|s| part_meshes(&posed_part_meshes(obj, &states[s]), parts.parts.len()));
-    for (k, mesh) in meshes[0].iter().enumerate() {
+    // The base may be empty (a door without its frame: there is nothing static to see); every movable part
+    // needs a surface, or it could be neither seen nor scored.
+    for (k, mesh) in meshes[0].iter().enumerate().skip(1) {
         if surface_area(mesh) <= 0.0 {
             let links: Vec<&str> = parts.parts[k]
                 .links

@@ -134,7 +134,13 @@ mod tests {
         let plan = suite_plan(true);
         assert_eq!(plan.len(), 16);
         for e in &plan {
-            assert!(e.params().category.movable_parts().contains(&e.movable_parts), "{e:?}");
+            assert!(
+                e.params()
+                    .category
+                    .movable_parts()
+                    .contains(&e.movable_parts),
+                "{e:?}"
+            );
         }
         for bucket in PartBucket::ALL {
             assert!(
