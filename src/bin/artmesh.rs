@@ -70,13 +70,19 @@ mod cli {
             parts: u8,
         },
         /// Score predicted joints and part meshes against ground truth with the metrics of the
-        /// paper's tables (Axis Ang, Axis Pos, Part Motion, CD-s, CD-m); prints JSON.
+        /// paper's tables (Axis Ang, Axis Pos, Part Motion, CD-s, CD-m); prints JSON. Given a suite
+        /// folder (with suite.json), scores every object (PRED/<id> against GT/<id>) and adds the
+        /// tables by part-count bucket and by category.
         Eval {
             /// Prediction: a folder laid out like a dataset's gt/ folder (trans.json,
-            /// {start,end}/{state}_static_rotate.ply, {state}_dynamic_{i}_rotate.ply), or one that contains gt/.
+            /// {start,end}/{state}_static_rotate.ply, {state}_dynamic_{i}_rotate.ply), or one that contains gt/;
+            /// for a suite, a folder with one such folder per object id.
             pred: PathBuf,
-            /// Ground truth: a dataset folder (its gt/ is used) or a gt/ folder.
+            /// Ground truth: a dataset folder (its gt/ is used) or a gt/ folder; or a suite folder.
             gt: PathBuf,
+            /// For a suite: print the two tables as Markdown instead of JSON.
+            #[arg(long)]
+            markdown: bool,
             /// State whose part meshes are compared (the paper reports the start state).
             #[arg(long, default_value = "start", value_parser = ["start", "end"])]
             state: String,
@@ -264,6 +270,7 @@ mod cli {
             Command::Eval {
                 pred,
                 gt,
+                markdown,
                 state,
                 id,
                 category,
@@ -274,6 +281,9 @@ mod cli {
                 } else {
                     State::Start
                 };
+                if gt.join("suite.json").is_file() {
+                    return evaluate_suite(&pred, &gt, state, samples, markdown);
+                }
                 let id = id.unwrap_or_else(|| folder_name(&gt));
                 let report = evaluate(&pred, &gt, state, &id, &category, samples)?;
                 out!("{}", to_json(&report)?);
@@ -403,6 +413,66 @@ mod cli {
         };
         eval::evaluate_object(id, category, pred_joints, gt_joints, meshes, &options)
             .map_err(|e| e.to_string())
+    }
+
+    /// Scores every object of a suite and prints the per-object reports and both benchmark tables.
+    fn evaluate_suite(
+        pred: &Path,
+        gt: &Path,
+        state: State,
+        samples: u32,
+        markdown: bool,
+    ) -> Result<ExitCode, String> {
+        #[derive(serde::Deserialize)]
+        struct Manifest {
+            objects: Vec<Entry>,
+        }
+        #[derive(serde::Deserialize)]
+        struct Entry {
+            id: String,
+            category: String,
+        }
+        let path = gt.join("suite.json");
+        let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+        let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
+            format!(
+                "{}: expected a suite manifest ({{\"objects\": [{{\"id\", \"category\"}}]}}): {e}",
+                path.display()
+            )
+        })?;
+        let mut reports = Vec::with_capacity(manifest.objects.len());
+        for o in &manifest.objects {
+            let report = evaluate(
+                &pred.join(&o.id),
+                &gt.join(&o.id),
+                state,
+                &o.id,
+                &o.category,
+                samples,
+            )
+            .map_err(|e| format!("{}: {e}", o.id))?;
+            reports.push(report);
+        }
+        let by_parts = eval::BenchmarkTable::by_part_count(&reports);
+        let by_category = eval::BenchmarkTable::by_category(&reports);
+        if markdown {
+            out!(
+                "By part count (the paper's Table 1)\n\n{}",
+                by_parts.to_markdown()
+            );
+            out!(
+                "By category (the paper's appendix table)\n\n{}",
+                by_category.to_markdown()
+            );
+        } else {
+            let json = serde_json::json!({
+                "objects": reports,
+                "by_part_count": by_parts,
+                "by_category": by_category,
+            });
+            out!("{}", to_json(&json)?);
+        }
+        Ok(ExitCode::SUCCESS)
     }
 
     fn folder_name(path: &Path) -> String {
