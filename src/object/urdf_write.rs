@@ -11,7 +11,7 @@ use std::collections::{BTreeSet, HashMap};
 use std::fmt::Write as _;
 use std::sync::Arc;
 
-use glam::{Affine3A, EulerRot, Quat, Vec3};
+use glam::{Affine3A, EulerRot, Vec3};
 
 use super::{ArticulatedObject, Geometry, JointKind, Material, RenderMesh, Visual, mesh_bounds};
 use crate::data::{DataError, FileSet, PngPixels, RgbaImage, encode_png};
@@ -138,7 +138,7 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
 /// `<origin xyz rpy>` of a rigid transform (URDF rpy = fixed-axis x, y, z = `Rz·Ry·Rx`).
 fn origin_xml(t: &Affine3A) -> String {
     let (_, rotation, translation) = t.to_scale_rotation_translation();
-    let (yaw, pitch, roll) = Quat::from(rotation).to_euler(EulerRot::ZYX);
+    let (yaw, pitch, roll) = rotation.to_euler(EulerRot::ZYX);
     format!(
         "<origin xyz=\"{} {} {}\" rpy=\"{roll} {pitch} {yaw}\"/>",
         translation.x, translation.y, translation.z

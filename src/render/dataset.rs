@@ -174,7 +174,8 @@ pub fn capture_truth(
             });
         }
         let (lower, upper) = joint.range().unwrap_or((0.0, 0.0));
-        if !(upper > lower) {
+        let opens = upper > lower; // false for NaN limits too
+        if !opens {
             return Err(ObjectProblem::EmptyRange {
                 joint: joint.name.clone(),
                 lower,
