@@ -133,3 +133,167 @@ fn eval_without_joints_is_a_clear_error() {
         text(&out.stderr)
     );
 }
+
+/// Every file below `root` with its bytes, keyed by relative path.
+fn tree(root: &str) -> data::FileSet {
+    data::read_dir(Path::new(root)).expect("readable output")
+}
+
+#[test]
+fn quick_suite_is_valid_reproducible_and_scores_zero_against_itself() {
+    let tmp = TempDir::new("suite");
+    let small = [
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--train-views",
+        "2",
+        "--test-views",
+        "1",
+    ];
+    let (a, b) = (tmp.join("a"), tmp.join("b"));
+    for dir in [&a, &b] {
+        let mut args = vec!["suite", "--quick", "--out", dir.as_str()];
+        args.extend(small);
+        let out = artmesh(&args);
+        assert!(out.status.success(), "{}", text(&out.stderr));
+    }
+    let files = tree(&a);
+    assert!(files == tree(&b), "two runs of the quick suite differ");
+    let manifest: serde_json::Value = serde_json::from_slice(&files["suite.json"]).unwrap();
+    let objects = manifest["objects"].as_array().unwrap();
+    assert_eq!(objects.len(), 16);
+    assert!(files.contains_key("contact-sheet.png"));
+    for o in objects {
+        let id = o["id"].as_str().unwrap();
+        let info = json(&artmesh(&["info", &format!("{a}/{id}"), "--json"]));
+        assert_eq!(info["num_parts"], o["parts"], "{id}: {info}");
+        let urdf = format!("{id}/object/{}.urdf", o["name"].as_str().unwrap());
+        assert!(files.contains_key(&urdf), "{urdf} missing");
+    }
+    // Ground truth fed as the prediction: zero error everywhere, in both tables.
+    let report = json(&artmesh(&["eval", &a, &a, "--samples", "500"]));
+    for table in ["by_part_count", "by_category"] {
+        for column in report[table]["columns"].as_array().unwrap() {
+            for metric in ["axis_ang", "axis_pos", "part_motion"] {
+                let v = &column[metric];
+                assert!(
+                    v.is_null() || v.as_f64() == Some(0.0),
+                    "{table} {}: {metric} = {v}",
+                    column["label"]
+                );
+            }
+        }
+    }
+    let all = report["by_part_count"]["columns"]
+        .as_array()
+        .unwrap()
+        .last()
+        .unwrap()
+        .clone();
+    assert_eq!(all["label"], "All");
+    assert_eq!(all["objects"], 16);
+    let md = artmesh(&["eval", &a, &a, "--samples", "200", "--markdown"]);
+    let md = text(&md.stdout);
+    assert!(
+        md.contains("| Metric |") && md.contains("StorageFurniture") && md.contains("6+ Parts"),
+        "{md}"
+    );
+}
+
+#[test]
+fn synth_and_render_write_datasets_and_refuse_bad_input() {
+    let tmp = TempDir::new("synth");
+    let small = [
+        "--width",
+        "24",
+        "--height",
+        "24",
+        "--train-views",
+        "2",
+        "--test-views",
+        "0",
+    ];
+    let dir = tmp.join("storage");
+    let mut args = vec![
+        "synth",
+        "--category",
+        "storage",
+        "--parts",
+        "5",
+        "--seed",
+        "7",
+        "--out",
+        dir.as_str(),
+    ];
+    args.extend(small);
+    let out = artmesh(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let info = json(&artmesh(&["info", &dir, "--json"]));
+    assert_eq!(info["num_parts"], 6, "{info}");
+    // The written object renders again through `artmesh render`.
+    let urdf = tmp.join("storage/object/storagefurniture_5p_s7.urdf");
+    let again = tmp.join("again");
+    let mut args = vec!["render", urdf.as_str(), "--out", again.as_str()];
+    args.extend(small);
+    let out = artmesh(&args);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    assert_eq!(json(&artmesh(&["info", &again, "--json"]))["num_parts"], 6);
+    // Refusals: non-empty output folder, unknown category, impossible part count, missing URDF, bad mesh.
+    let before = tree(&dir);
+    let out = artmesh(&["synth", "--category", "storage", "--out", &dir]);
+    assert!(!out.status.success());
+    assert!(
+        text(&out.stderr).contains("not empty"),
+        "{}",
+        text(&out.stderr)
+    );
+    assert!(tree(&dir) == before, "a refused run changed the folder");
+    let out = artmesh(&["synth", "--category", "sofa", "--out", &tmp.join("x")]);
+    assert!(
+        text(&out.stderr).contains("unknown category 'sofa'"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = artmesh(&[
+        "synth",
+        "--category",
+        "laptop",
+        "--parts",
+        "4",
+        "--out",
+        &tmp.join("x"),
+    ]);
+    assert!(
+        text(&out.stderr).contains("Laptop objects have 1..=1 movable parts"),
+        "{}",
+        text(&out.stderr)
+    );
+    let out = artmesh(&["render", &tmp.join("none.urdf"), "--out", &tmp.join("x")]);
+    assert!(
+        text(&out.stderr).contains("none.urdf: no such file"),
+        "{}",
+        text(&out.stderr)
+    );
+    let broken = tmp.join("broken");
+    std::fs::create_dir_all(&broken).unwrap();
+    for (name, mesh) in [("missing", "gone.obj"), ("format", "door.fbx")] {
+        let path = format!("{broken}/{name}.urdf");
+        std::fs::write(&path, format!(
+            r#"<robot name="r"><link name="a"/><link name="b"><visual><geometry><mesh filename="{mesh}"/></geometry></visual></link>
+            <joint name="j" type="revolute"><parent link="a"/><child link="b"/><limit lower="0" upper="1"/></joint></robot>"#
+        ))
+        .unwrap();
+        if name == "format" {
+            std::fs::write(format!("{broken}/door.fbx"), b"Kaydara FBX Binary").unwrap();
+        }
+        let out = artmesh(&["render", &path, "--out", &tmp.join(name)]);
+        let err = text(&out.stderr);
+        assert!(!out.status.success() && err.contains(mesh), "{name}: {err}");
+        assert!(
+            !Path::new(&tmp.join(name)).exists(),
+            "{name}: output written despite the error"
+        );
+    }
+}
