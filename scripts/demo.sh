@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
-# The README's main-job command. Today: writes the built-in sample object (a synthetic two-state
-# dataset with depth, part maps and ground-truth joints), checks it with `artmesh info`, and runs
-# the GPU self-test on this machine's adapter. The fit itself joins once the reconstruction and
-# articulation phases land. Usage: scripts/demo.sh [OUTPUT_DIR]
+# The README's main-job command. Today: generates the built-in default object (a procedural
+# StorageFurniture cabinet with drawers and doors, seed 7), captures it as a two-state RGB-D dataset
+# with part maps and ground truth, checks the dataset with `artmesh info`, scores the ground truth
+# against itself with `artmesh eval` (all zeros), and runs the GPU self-test. The fit itself joins
+# once the reconstruction and articulation phases land. Usage: scripts/demo.sh [OUTPUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh --native
@@ -10,7 +11,10 @@ export WGPU_BACKEND=${WGPU_BACKEND:-vulkan}
 export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/artmesh-xdg-$(id -u)}
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 cargo build --release --bin artmesh
-out=${1:-$(mktemp -d "${TMPDIR:-/tmp}/artmesh-demo.XXXXXX")/sample}
-target/release/artmesh sample --out "$out"
+out=${1:-$(mktemp -d "${TMPDIR:-/tmp}/artmesh-demo.XXXXXX")/cabinet}
+target/release/artmesh synth --category storage --parts 5 --seed 7 --out "$out" \
+    --width 400 --height 400 --train-views 40 --test-views 8
 target/release/artmesh info "$out"
+target/release/artmesh eval "$out" "$out" --samples 2000 | grep -E '"(axis_ang|axis_pos|part_motion)"' | sort | uniq -c
 target/release/artmesh gpu
+echo "dataset in $out (object as URDF in $out/object)"

@@ -208,6 +208,16 @@ mod cli {
 
     #[derive(Subcommand)]
     enum Bench {
+        /// Dataset capture throughput (frames/s: render, readback, PNG encoding) of a 7-part
+        /// procedural cabinet.
+        Capture {
+            /// Square image sizes to time.
+            #[arg(long, value_delimiter = ',', default_values_t = [200u32, 800])]
+            sizes: Vec<u32>,
+            /// Train views per state (frames = 2 x views).
+            #[arg(long, default_value_t = 10)]
+            views: usize,
+        },
         /// Radix-sort throughput (keys/s) on the current adapter.
         Sort {
             /// Key counts to time.
@@ -333,6 +343,14 @@ mod cli {
             } => {
                 let ctx = context()?;
                 capture::suite(&ctx, &out, quick, &capture)?;
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Bench {
+                which: Bench::Capture { sizes, views },
+            } => {
+                let ctx = context()?;
+                let report = artmesh::bench::capture(&ctx, &sizes, views)?;
+                out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
             Command::Bench {
