@@ -4,10 +4,9 @@
 //! are refused with clear errors.
 #![cfg(not(target_arch = "wasm32"))]
 
-use std::path::Path;
 use std::sync::OnceLock;
 
-use artmesh::data::{Dataset, FileSet, GtJoint, JointKind as GtKind, State, read_dir};
+use artmesh::data::{Dataset, FileSet, GtJoint, JointKind as GtKind, State};
 use artmesh::eval::{EvalOptions, evaluate_object};
 use artmesh::gpu::GpuContext;
 use artmesh::object::{ArticulatedObject, JointKind, Material};
@@ -24,16 +23,9 @@ fn context() -> &'static GpuContext {
     CTX.get_or_init(|| block_on(GpuContext::new()).expect("a GPU adapter (lavapipe in CI)"))
 }
 
-fn objects() -> &'static FileSet {
-    static FILES: OnceLock<FileSet> = OnceLock::new();
-    FILES.get_or_init(|| {
-        read_dir(Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/objects"
-        )))
-        .expect("../shared/objects is readable")
-    })
-}
+mod common;
+
+use common::shared_objects as objects;
 
 fn small_spec(seed: u64, train_views: usize) -> RenderSpec {
     RenderSpec {

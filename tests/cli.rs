@@ -139,10 +139,10 @@ fn tree(root: &str) -> data::FileSet {
     data::read_dir(Path::new(root)).expect("readable output")
 }
 
-#[test]
-fn quick_suite_is_valid_reproducible_and_scores_zero_against_itself() {
-    let tmp = TempDir::new("suite");
-    let small = [
+/// `args` followed by capture options for tiny, fast datasets.
+fn with_small_capture<'a>(args: &[&'a str], test_views: &'a str) -> Vec<&'a str> {
+    let mut all = args.to_vec();
+    all.extend([
         "--width",
         "24",
         "--height",
@@ -150,13 +150,20 @@ fn quick_suite_is_valid_reproducible_and_scores_zero_against_itself() {
         "--train-views",
         "2",
         "--test-views",
-        "1",
-    ];
+        test_views,
+    ]);
+    all
+}
+
+#[test]
+fn quick_suite_is_valid_reproducible_and_scores_zero_against_itself() {
+    let tmp = TempDir::new("suite");
     let (a, b) = (tmp.join("a"), tmp.join("b"));
     for dir in [&a, &b] {
-        let mut args = vec!["suite", "--quick", "--out", dir.as_str()];
-        args.extend(small);
-        let out = artmesh(&args);
+        let out = artmesh(&with_small_capture(
+            &["suite", "--quick", "--out", dir],
+            "1",
+        ));
         assert!(out.status.success(), "{}", text(&out.stderr));
     }
     let files = tree(&a);
@@ -205,18 +212,8 @@ fn quick_suite_is_valid_reproducible_and_scores_zero_against_itself() {
 #[test]
 fn synth_and_render_write_datasets_and_refuse_bad_input() {
     let tmp = TempDir::new("synth");
-    let small = [
-        "--width",
-        "24",
-        "--height",
-        "24",
-        "--train-views",
-        "2",
-        "--test-views",
-        "0",
-    ];
     let dir = tmp.join("storage");
-    let mut args = vec![
+    let synth = [
         "synth",
         "--category",
         "storage",
@@ -225,19 +222,19 @@ fn synth_and_render_write_datasets_and_refuse_bad_input() {
         "--seed",
         "7",
         "--out",
-        dir.as_str(),
+        &dir,
     ];
-    args.extend(small);
-    let out = artmesh(&args);
+    let out = artmesh(&with_small_capture(&synth, "0"));
     assert!(out.status.success(), "{}", text(&out.stderr));
     let info = json(&artmesh(&["info", &dir, "--json"]));
     assert_eq!(info["num_parts"], 6, "{info}");
     // The written object renders again through `artmesh render`.
     let urdf = tmp.join("storage/object/storagefurniture_5p_s7.urdf");
     let again = tmp.join("again");
-    let mut args = vec!["render", urdf.as_str(), "--out", again.as_str()];
-    args.extend(small);
-    let out = artmesh(&args);
+    let out = artmesh(&with_small_capture(
+        &["render", &urdf, "--out", &again],
+        "0",
+    ));
     assert!(out.status.success(), "{}", text(&out.stderr));
     assert_eq!(json(&artmesh(&["info", &again, "--json"]))["num_parts"], 6);
     // Refusals: non-empty output folder, unknown category, impossible part count, missing URDF, bad mesh.

@@ -3,24 +3,14 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use std::f32::consts::FRAC_PI_2;
-use std::path::Path;
-use std::sync::OnceLock;
 
-use artmesh::data::{FileSet, read_dir};
+use artmesh::data::FileSet;
 use artmesh::object::{ArticulatedObject, Geometry, JointKind};
 use glam::{Quat, Vec3};
 
-/// The shared objects folder, read once for all tests.
-fn objects() -> &'static FileSet {
-    static FILES: OnceLock<FileSet> = OnceLock::new();
-    FILES.get_or_init(|| {
-        read_dir(Path::new(concat!(
-            env!("CARGO_MANIFEST_DIR"),
-            "/../shared/objects"
-        )))
-        .expect("../shared/objects is readable")
-    })
-}
+mod common;
+
+use common::shared_objects as objects;
 
 fn import(path: &str) -> ArticulatedObject {
     ArticulatedObject::from_urdf(path, objects()).unwrap_or_else(|e| panic!("{path}: {e}"))

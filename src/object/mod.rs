@@ -42,6 +42,7 @@ use crate::data::{DataError, FileSet, RgbaImage};
 
 pub use mesh_io::{MeshFormat, load_mesh};
 pub use parts::{MERGE_PRISMATIC_SPAN, MERGE_REVOLUTE_SPAN, Part, Parts, is_merged_chain_joint};
+pub(crate) use primitives::BOX_FACES;
 pub use primitives::{box_mesh, cylinder_mesh, sphere_mesh};
 pub use urdf_write::write_urdf;
 

@@ -14,21 +14,22 @@ const SEGMENTS: u32 = 32;
 /// Latitude bands of the sphere.
 const STACKS: u32 = 16;
 
+/// The six faces of a box: outward normal and two in-face axes u, v with u × v = normal (counter-clockwise).
+pub(crate) const BOX_FACES: [(Vec3, Vec3, Vec3); 6] = [
+    (Vec3::X, Vec3::Y, Vec3::Z),
+    (Vec3::NEG_X, Vec3::Z, Vec3::Y),
+    (Vec3::Y, Vec3::Z, Vec3::X),
+    (Vec3::NEG_Y, Vec3::X, Vec3::Z),
+    (Vec3::Z, Vec3::X, Vec3::Y),
+    (Vec3::NEG_Z, Vec3::Y, Vec3::X),
+];
+
 /// Box with full side lengths `size`, 24 vertices and 12 triangles.
 pub fn box_mesh(size: Vec3, material: Material) -> RenderMesh {
     let h = size * 0.5;
     let mut m = empty(material);
-    // For each face: outward normal and two in-face axes u, v with u × v = normal (counter-clockwise).
-    let faces = [
-        (Vec3::X, Vec3::Y, Vec3::Z),
-        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::Z, Vec3::X),
-        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (Vec3::NEG_Z, Vec3::Y, Vec3::X),
-    ];
     let uvs = m.uvs.get_or_insert_with(Vec::new);
-    for (n, u, v) in faces {
+    for (n, u, v) in BOX_FACES {
         let base = m.positions.len() as u32;
         for (su, sv) in [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)] {
             m.positions.push((n + u * su + v * sv) * h);

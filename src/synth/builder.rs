@@ -13,8 +13,8 @@ use glam::{Affine3A, Quat, Vec2, Vec3};
 
 use super::texture::TILE_METRES;
 use crate::object::{
-    ArticulatedObject, Geometry, Joint, JointKind, Limit, Link, Material, RenderMesh, Visual,
-    mesh_bounds,
+    ArticulatedObject, BOX_FACES, Geometry, Joint, JointKind, Limit, Link, Material, RenderMesh,
+    Visual, mesh_bounds,
 };
 
 /// Segments around round shapes.
@@ -56,16 +56,7 @@ pub fn cuboid(centre: Vec3, size: Vec3, material: &Material) -> RenderMesh {
 pub fn oriented_cuboid(pose: Affine3A, size: Vec3, material: &Material) -> RenderMesh {
     let mut m = empty(material);
     let h = size * 0.5;
-    // (normal axis, u axis, v axis) with u × v = normal.
-    let faces = [
-        (Vec3::X, Vec3::Y, Vec3::Z),
-        (Vec3::NEG_X, Vec3::Z, Vec3::Y),
-        (Vec3::Y, Vec3::Z, Vec3::X),
-        (Vec3::NEG_Y, Vec3::X, Vec3::Z),
-        (Vec3::Z, Vec3::X, Vec3::Y),
-        (Vec3::NEG_Z, Vec3::Y, Vec3::X),
-    ];
-    for (n, u, v) in faces {
+    for (n, u, v) in BOX_FACES {
         let corner = (n - u - v) * h;
         push_quad(&mut m, corner, 2.0 * u * h, 2.0 * v * h);
     }
@@ -144,15 +135,20 @@ pub fn sphere(centre: Vec3, r: f32, material: &Material) -> RenderMesh {
             uvs.push(Vec2::new(theta * r, phi * r) / TILE_METRES);
         }
     }
-    let row = SEGMENTS + 1;
-    for j in 0..stacks {
-        for i in 0..SEGMENTS {
+    grid_triangles(&mut m, stacks, SEGMENTS);
+    m
+}
+
+/// Two triangles per cell of a `(rows + 1) × (cols + 1)` vertex grid stored row by row.
+fn grid_triangles(m: &mut RenderMesh, rows: u32, cols: u32) {
+    let row = cols + 1;
+    for j in 0..rows {
+        for i in 0..cols {
             let (a, b) = (j * row + i, (j + 1) * row + i);
             m.indices.push([a, b, b + 1]);
             m.indices.push([a, b + 1, a + 1]);
         }
     }
-    m
 }
 
 /// Torus around `axis` through `centre`: ring radius `major`, tube radius `minor`.
@@ -171,14 +167,7 @@ pub fn torus(centre: Vec3, axis: Vec3, major: f32, minor: f32, material: &Materi
             uvs.push(Vec2::new(theta * major, phi * minor) / TILE_METRES);
         }
     }
-    let row = tube + 1;
-    for i in 0..SEGMENTS {
-        for j in 0..tube {
-            let (a, b) = (i * row + j, (i + 1) * row + j);
-            m.indices.push([a, b, b + 1]);
-            m.indices.push([a, b + 1, a + 1]);
-        }
-    }
+    grid_triangles(&mut m, SEGMENTS, tube);
     m.transformed(&Affine3A::from_rotation_translation(z_to(axis), centre))
 }
 

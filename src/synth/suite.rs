@@ -103,6 +103,13 @@ pub fn suite_plan(quick: bool) -> Vec<SuiteEntry> {
 mod tests {
     use super::*;
 
+    fn assert_part_counts_fit(plan: &[SuiteEntry]) {
+        for e in plan {
+            let range = e.params().category.movable_parts();
+            assert!(range.contains(&e.movable_parts), "{e:?}");
+        }
+    }
+
     #[test]
     fn full_suite_has_the_paper_proportions_and_every_category() {
         let plan = suite_plan(false);
@@ -117,15 +124,7 @@ mod tests {
         for c in Category::ALL {
             assert!(plan.iter().any(|e| e.category == c.name()), "{c} missing");
         }
-        for e in &plan {
-            assert!(
-                e.params()
-                    .category
-                    .movable_parts()
-                    .contains(&e.movable_parts),
-                "{e:?}"
-            );
-        }
+        assert_part_counts_fit(&plan);
         assert_eq!(plan, suite_plan(false));
     }
 
@@ -133,15 +132,7 @@ mod tests {
     fn quick_suite_covers_categories_and_buckets() {
         let plan = suite_plan(true);
         assert_eq!(plan.len(), 16);
-        for e in &plan {
-            assert!(
-                e.params()
-                    .category
-                    .movable_parts()
-                    .contains(&e.movable_parts),
-                "{e:?}"
-            );
-        }
+        assert_part_counts_fit(&plan);
         for bucket in PartBucket::ALL {
             assert!(
                 plan.iter()
