@@ -78,8 +78,14 @@ pub struct WriteOptions {
 pub(crate) fn implied_num_parts(
     joints: Option<&[GtJoint]>,
     max_id: Option<i16>,
-    max_movable_meshes: usize,
+    meshes: &[Option<GtMeshes>; 2],
 ) -> usize {
+    let max_movable_meshes = meshes
+        .iter()
+        .flatten()
+        .map(|m| m.movable.len())
+        .max()
+        .unwrap_or(0);
     match joints {
         Some(j) => 1 + j.len(),
         None => {
@@ -140,13 +146,7 @@ impl Dataset {
             .flat_map(|v| &v.frames)
             .filter_map(|f| f.parts.as_ref()?.max_id())
             .max();
-        let max_meshes = meshes
-            .iter()
-            .flatten()
-            .map(|m| m.movable.len())
-            .max()
-            .unwrap_or(0);
-        let num_parts = implied_num_parts(gt_joints.as_deref(), max_id, max_meshes);
+        let num_parts = implied_num_parts(gt_joints.as_deref(), max_id, &meshes);
         check_mesh_counts(&meshes, num_parts, gt_joints.is_some(), &mut errs);
         errs.finish(Dataset {
             views,

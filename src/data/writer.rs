@@ -175,13 +175,7 @@ impl DatasetWriter {
                 ));
             }
         }
-        let max_meshes = gt_meshes
-            .iter()
-            .flatten()
-            .map(|m| m.movable.len())
-            .max()
-            .unwrap_or(0);
-        let implied = implied_num_parts(gt_joints, self.max_id, max_meshes);
+        let implied = implied_num_parts(gt_joints, self.max_id, gt_meshes);
         if implied != num_parts {
             return Err(DataError::field(
                 GT_TRANS_PATH,
