@@ -105,7 +105,8 @@ fn layout(n: usize, rng: &mut Rng) -> (Vec<Band>, bool, f32, f32) {
                     fills: drawers(c),
                 })
                 .collect();
-            if rows.len() <= 2 && rng.chance(0.5) {
+            // Low chests get an open niche below (a nightstand) so they do not read as a bare box.
+            if rows.len() == 1 || (rows.len() == 2 && rng.chance(0.5)) {
                 bands.insert(
                     0,
                     Band {
