@@ -2,6 +2,14 @@
 //! (within [`Category::movable_parts`]), built with [`super::builder::ObjectBuilder`].
 
 mod laptop;
+mod refrigerator;
+mod shapes_b;
+mod storage_furniture;
+mod suitcase;
+mod table;
+mod toilet;
+mod trash_can;
+mod window;
 
 use super::Category;
 use crate::object::ArticulatedObject;
@@ -11,6 +19,13 @@ use crate::rng::Rng;
 pub(super) fn build(category: Category, parts: usize, rng: &mut Rng) -> ArticulatedObject {
     match category {
         Category::Laptop => laptop::build(parts, rng),
+        Category::Refrigerator => refrigerator::build(parts, rng),
+        Category::StorageFurniture => storage_furniture::build(parts, rng),
+        Category::Suitcase => suitcase::build(parts, rng),
+        Category::Table => table::build(parts, rng),
+        Category::Toilet => toilet::build(parts, rng),
+        Category::TrashCan => trash_can::build(parts, rng),
+        Category::Window => window::build(parts, rng),
         _ => laptop::build(parts, rng),
     }
 }
