@@ -1,7 +1,16 @@
 //! One generator per category. Each `build(parts, rng)` returns an object with exactly `parts` movable parts
 //! (within [`Category::movable_parts`]), built with [`super::builder::ObjectBuilder`].
 
+mod box_;
+mod eyeglasses;
+mod faucet;
+mod folding_chair;
+mod knife;
 mod laptop;
+mod oven;
+mod pen;
+mod pliers;
+mod shapes_a;
 
 use super::Category;
 use crate::object::ArticulatedObject;
@@ -10,7 +19,15 @@ use crate::rng::Rng;
 /// Dispatches to the category's generator.
 pub(super) fn build(category: Category, parts: usize, rng: &mut Rng) -> ArticulatedObject {
     match category {
+        Category::Box => box_::build(parts, rng),
+        Category::Eyeglasses => eyeglasses::build(parts, rng),
+        Category::Faucet => faucet::build(parts, rng),
+        Category::FoldingChair => folding_chair::build(parts, rng),
+        Category::Knife => knife::build(parts, rng),
         Category::Laptop => laptop::build(parts, rng),
+        Category::Oven => oven::build(parts, rng),
+        Category::Pen => pen::build(parts, rng),
+        Category::Pliers => pliers::build(parts, rng),
         _ => laptop::build(parts, rng),
     }
 }
