@@ -93,7 +93,7 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
         b.add(base, member(yz(x, a_foot), yz(x, a_seat), r, wood, &frame));
         b.add(base, member(yz(x, a_seat), yz(x, a_top), r, wood, &frame));
     }
-    // Foot rail between the front feet, and a rail behind the seat's back edge.
+    // Foot rail between the front feet.
     let rail_a = a_foot + (a_seat - a_foot) * 0.15;
     b.add(
         base,

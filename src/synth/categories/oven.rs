@@ -85,7 +85,7 @@ fn knob(
 ) {
     let turn = rng.uniform(0.75, 1.5) * PI;
     let link = if moves {
-        // About −y (out of the face): positive angles turn it clockwise as seen from the front.
+        // About −y (out of the face): positive angles turn it counter-clockwise as seen from the front.
         b.joint(
             name,
             ObjectBuilder::BASE,
