@@ -179,9 +179,6 @@ pub struct SynthParams {
 /// The object's name is `<category>_<parts>p_s<seed>`.
 pub fn generate(params: &SynthParams) -> Result<ArticulatedObject, String> {
     let range = params.category.movable_parts();
-    // Mix the category into the seed so seed 0 of two categories do not share their random stream.
-    let mut rng =
-        Rng::new(params.seed ^ (params.category as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15));
     let parts = match params.movable_parts {
         Some(n) if range.contains(&n) => n,
         Some(n) => {
@@ -192,8 +189,14 @@ pub fn generate(params: &SynthParams) -> Result<ArticulatedObject, String> {
                 range.end()
             ));
         }
-        None => rng.int_in(*range.start(), *range.end()),
+        None => Rng::new(params.seed).int_in(*range.start(), *range.end()),
     };
+    // Mix category and part count into the seed, so one seed gives unrelated shapes across categories and
+    // part counts rather than the same layout with a different number of doors.
+    let mixed = params.seed
+        ^ (params.category as u64 + 1).wrapping_mul(0x9e37_79b9_7f4a_7c15)
+        ^ (parts as u64 + 1).wrapping_mul(0xc2b2_ae3d_27d4_eb4f);
+    let mut rng = Rng::new(mixed);
     let mut object = categories::build(params.category, parts, &mut rng);
     object.name = format!("{}_{parts}p_s{}", params.category.slug(), params.seed);
     let got = object.parts().movable_count();

@@ -101,7 +101,7 @@ pub fn texture(finish: Finish, base: [f32; 3], seed: u64) -> RgbaImage {
     let speckle = PeriodicNoise::new(&mut rng, 32, 32);
     // Elongated along u: wood fibres and brush streaks.
     let streaks = PeriodicNoise::new(&mut rng, 4, 64);
-    let rings = 3.0 + rng.below(4) as f32; // growth rings per tile (wood)
+    let rings = 10.0 + rng.below(8) as f32; // growth rings per tile (wood): a ring every 3 to 5 cm
     let mut pixels = Vec::with_capacity(n * n * 4);
     for y in 0..n {
         for x in 0..n {
@@ -112,7 +112,7 @@ pub fn texture(finish: Finish, base: [f32; 3], seed: u64) -> RgbaImage {
                     let warp = coarse.fractal(u * 4.0, v * 4.0, 3);
                     let ring = (std::f32::consts::TAU * (v * rings + 1.5 * warp)).sin();
                     let fibre = streaks.at(u * 4.0, v * 64.0);
-                    0.75 + 0.2 * ring + 0.12 * (fibre - 0.5)
+                    0.8 + 0.12 * ring + 0.12 * (fibre - 0.5)
                 }
                 Finish::Paint => {
                     let blotch = coarse.fractal(u * 4.0, v * 4.0, 2);
