@@ -20,7 +20,8 @@ use crate::object::{
 /// Segments around round shapes.
 const SEGMENTS: u32 = 24;
 
-fn empty(material: &Material) -> RenderMesh {
+/// A mesh with no vertices yet (and an empty UV list), to push shapes into.
+pub(crate) fn empty(material: &Material) -> RenderMesh {
     RenderMesh {
         positions: Vec::new(),
         normals: Vec::new(),
@@ -290,12 +291,15 @@ impl ObjectBuilder {
     }
 }
 
+/// Checks shared by the shape tests of the builder and the category shapes.
 #[cfg(test)]
-mod tests {
-    use super::*;
+pub(crate) mod test_support {
+    use crate::object::RenderMesh;
 
-    /// Every triangle's winding agrees with its vertex normals, and normals are unit length.
-    fn assert_outward(m: &RenderMesh) {
+    /// The mesh has triangles, a normal and a UV per vertex, unit normals, and every triangle's winding
+    /// agrees with its vertex normals.
+    pub(crate) fn assert_outward(m: &RenderMesh) {
+        assert!(!m.indices.is_empty());
         assert_eq!(m.positions.len(), m.normals.len());
         assert_eq!(m.uvs.as_ref().map(Vec::len), Some(m.positions.len()));
         for n in &m.normals {
@@ -314,6 +318,12 @@ mod tests {
             );
         }
     }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::test_support::assert_outward;
+    use super::*;
 
     #[test]
     fn shapes_wind_outward() {

@@ -101,36 +101,11 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     let top = h + GAP;
     if parts == 1 {
         let open = rng.uniform(0.6, 0.85) * PI;
-        let lid = back_lid(
-            &mut b,
-            "lid",
-            (-w / 2.0 - over, w / 2.0 + over),
-            d,
-            top,
-            over,
-            open,
-        );
-        add_lid_slab(
-            &mut b,
-            lid,
-            (-w / 2.0 - over, w / 2.0 + over),
-            d,
-            top,
-            over,
-            lid_t,
-            &lid_mat,
-        );
+        let xs = (-w / 2.0 - over, w / 2.0 + over);
+        let lid = back_lid(&mut b, "lid", xs, d, top, over, open);
+        add_lid_slab(&mut b, lid, xs, d, top, over, lid_t, &lid_mat);
         if style != Style::Cardboard {
-            add_lid_fittings(
-                &mut b,
-                lid,
-                (-w / 2.0 - over, w / 2.0 + over),
-                d,
-                top,
-                over,
-                lid_t,
-                &trim,
-            );
+            add_lid_fittings(&mut b, lid, xs, d, top, over, lid_t, &trim);
         }
     } else if style == Style::Cardboard || rng.chance(0.3) {
         add_flaps(

@@ -41,6 +41,30 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     b.build()
 }
 
+/// The link the spout hangs on: when it `moves`, a swivel about the column axis at height `z` turning both
+/// ways by a swing drawn from `swing` (only then is the generator advanced); otherwise the base.
+fn spout_link(
+    b: &mut ObjectBuilder,
+    moves: bool,
+    z: f32,
+    swing: (f32, f32),
+    rng: &mut Rng,
+) -> usize {
+    if !moves {
+        return ObjectBuilder::BASE;
+    }
+    let swing = rng.uniform(swing.0, swing.1);
+    b.joint(
+        "spout",
+        ObjectBuilder::BASE,
+        JointKind::Revolute,
+        Vec3::new(0.0, 0.0, z),
+        Vec3::Z,
+        -swing,
+        swing,
+    )
+}
+
 /// Single-lever mixer: column, swivel spout, lifting lever on top.
 fn mixer(
     b: &mut ObjectBuilder,
@@ -84,20 +108,7 @@ fn mixer(
     let zs = h * rng.uniform(0.45, 0.6);
     let len = rng.uniform(0.12, 0.2);
     let rise = rng.uniform(0.0, 0.02).min(h - zs - rs - 0.02);
-    let spout = if spout_moves {
-        let swing = rng.uniform(0.6, 1.1);
-        b.joint(
-            "spout",
-            base,
-            JointKind::Revolute,
-            Vec3::new(0.0, 0.0, zs),
-            Vec3::Z,
-            -swing,
-            swing,
-        )
-    } else {
-        base
-    };
+    let spout = spout_link(b, spout_moves, zs, (0.6, 1.1), rng);
     let collar = rs + 0.006;
     b.add(
         spout,
@@ -275,20 +286,7 @@ fn two_handles(
             chrome,
         ),
     );
-    let spout = if parts == 3 {
-        let swing = rng.uniform(0.5, 1.0);
-        b.joint(
-            "spout",
-            base,
-            JointKind::Revolute,
-            Vec3::new(0.0, 0.0, h),
-            Vec3::Z,
-            -swing,
-            swing,
-        )
-    } else {
-        base
-    };
+    let spout = spout_link(b, parts == 3, h, (0.5, 1.0), rng);
     b.add(
         spout,
         cylinder(

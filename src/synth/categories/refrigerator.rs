@@ -5,8 +5,8 @@
 
 use glam::Vec3;
 
-use super::shapes_b::{GAP, Open, open_box, slab, splits};
-use crate::object::{ArticulatedObject, JointKind, Material};
+use super::shapes_b::{GAP, Open, door_leaf, drawer_front, open_box, slab, splits};
+use crate::object::{ArticulatedObject, Material};
 use crate::rng::Rng;
 use crate::synth::builder::{ObjectBuilder, cylinder};
 use crate::synth::texture::{Finish, material, random_material};
@@ -81,28 +81,7 @@ fn fridge_door(
     let [x0, x1, z0, z1] = rect;
     let t = s.door_t;
     let yf = y_face - GAP;
-    let (hx, axis) = if hinge_left {
-        (x0 + GAP, Vec3::NEG_Z)
-    } else {
-        (x1 - GAP, Vec3::Z)
-    };
-    let link = b.joint(
-        name,
-        ObjectBuilder::BASE,
-        JointKind::Revolute,
-        Vec3::new(hx, yf - t, (z0 + z1) * 0.5),
-        axis,
-        0.0,
-        upper,
-    );
-    b.add(
-        link,
-        slab(
-            Vec3::new(x0 + GAP, yf - t, z0 + GAP),
-            Vec3::new(x1 - GAP, yf, z1 - GAP),
-            &s.shell,
-        ),
-    );
+    let link = door_leaf(b, name, rect, y_face, hinge_left, upper, t, &s.shell);
     // Inner panel and bins reach into the opening, clear of its walls.
     let [ox0, ox1, oz0, oz1] = opening;
     let (ix0, ix1) = (ox0 + 0.012, ox1 - 0.012);
@@ -137,25 +116,17 @@ fn fridge_door(
         z0 + (z1 - z0) * 0.5
     };
     let yb = yf - t - 0.035;
-    b.add(
+    bar_handle(
+        b,
         link,
-        cylinder(
+        [
             Vec3::new(hx, yb, zc - len / 2.0),
             Vec3::new(hx, yb, zc + len / 2.0),
-            0.011,
-            &s.handle,
-        ),
+        ],
+        [-0.45f32, 0.45].map(|e| Vec3::new(hx, yb, zc + len * e)),
+        yf - t,
+        &s.handle,
     );
-    for e in [-0.45f32, 0.45] {
-        b.add(
-            link,
-            slab(
-                Vec3::new(hx - 0.008, yb, zc + len * e - 0.008),
-                Vec3::new(hx + 0.008, yf - t, zc + len * e + 0.008),
-                &s.handle,
-            ),
-        );
-    }
 }
 
 /// A freezer drawer: front covering `rect`, wire-like basket inside `opening`, horizontal bar on top.
@@ -172,23 +143,7 @@ fn freezer_drawer(
     let [x0, x1, z0, z1] = rect;
     let t = s.door_t;
     let yf = y_face - GAP;
-    let link = b.joint(
-        name,
-        ObjectBuilder::BASE,
-        JointKind::Prismatic,
-        Vec3::new((x0 + x1) * 0.5, y_face, (z0 + z1) * 0.5),
-        Vec3::NEG_Y,
-        0.0,
-        depth * 0.75,
-    );
-    b.add(
-        link,
-        slab(
-            Vec3::new(x0 + GAP, yf - t, z0 + GAP),
-            Vec3::new(x1 - GAP, yf, z1 - GAP),
-            &s.shell,
-        ),
-    );
+    let link = drawer_front(b, name, rect, y_face, depth * 0.75, t, &s.shell);
     let [ox0, ox1, oz0, oz1] = opening;
     open_box(
         b,
@@ -203,22 +158,34 @@ fn freezer_drawer(
     let yb = yf - t - 0.035;
     let half = (x1 - x0) * 0.3;
     let xc = (x0 + x1) * 0.5;
-    b.add(
+    bar_handle(
+        b,
         link,
-        cylinder(
-            Vec3::new(xc - half, yb, zb),
-            Vec3::new(xc + half, yb, zb),
-            0.011,
-            &s.handle,
-        ),
+        [Vec3::new(xc - half, yb, zb), Vec3::new(xc + half, yb, zb)],
+        [-0.9f32, 0.9].map(|e| Vec3::new(xc + half * e, yb, zb)),
+        yf - t,
+        &s.handle,
     );
-    for e in [-0.9f32, 0.9] {
+}
+
+/// A round bar from `ends[0]` to `ends[1]` held by two square standoffs, centred on `feet` (on the bar's
+/// axis), that reach back to the door face at `y = y_back`.
+fn bar_handle(
+    b: &mut ObjectBuilder,
+    link: usize,
+    ends: [Vec3; 2],
+    feet: [Vec3; 2],
+    y_back: f32,
+    material: &Material,
+) {
+    b.add(link, cylinder(ends[0], ends[1], 0.011, material));
+    for p in feet {
         b.add(
             link,
             slab(
-                Vec3::new(xc + half * e - 0.008, yb, zb - 0.008),
-                Vec3::new(xc + half * e + 0.008, yf - t, zb + 0.008),
-                &s.handle,
+                Vec3::new(p.x - 0.008, p.y, p.z - 0.008),
+                Vec3::new(p.x + 0.008, y_back, p.z + 0.008),
+                material,
             ),
         );
     }

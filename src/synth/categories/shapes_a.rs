@@ -8,17 +8,8 @@ use std::f32::consts::TAU;
 use glam::{Affine3A, Quat, Vec2, Vec3};
 
 use crate::object::{Material, RenderMesh};
+use crate::synth::builder::empty;
 use crate::synth::texture::TILE_METRES;
-
-fn empty(material: &Material) -> RenderMesh {
-    RenderMesh {
-        positions: Vec::new(),
-        normals: Vec::new(),
-        uvs: Some(Vec::new()),
-        indices: Vec::new(),
-        material: material.clone(),
-    }
-}
 
 /// Pushes one vertex with its normal and UV (in metres, scaled to texture tiles).
 fn vertex(m: &mut RenderMesh, p: Vec3, n: Vec3, uv_metres: Vec2) {
@@ -219,27 +210,15 @@ pub fn rotation_about(pivot: Vec3, axis: Vec3, angle: f32) -> Affine3A {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::synth::builder::test_support;
 
+    /// The shared winding checks, plus: every face of these convex test shapes looks away from the centre.
     fn assert_outward(m: &RenderMesh) {
-        assert!(!m.indices.is_empty());
-        assert_eq!(m.uvs.as_ref().map(Vec::len), Some(m.positions.len()));
+        test_support::assert_outward(m);
         let centre = m.positions.iter().copied().sum::<Vec3>() / m.positions.len() as f32;
-        for n in &m.normals {
-            assert!((n.length() - 1.0).abs() < 1e-4);
-        }
         for t in &m.indices {
             let [a, b, c] = t.map(|i| m.positions[i as usize]);
-            let face = (b - a).cross(c - a);
-            if face.length() < 1e-10 {
-                continue;
-            }
-            let n = m.normals[t[0] as usize] + m.normals[t[1] as usize] + m.normals[t[2] as usize];
-            assert!(
-                face.dot(n) > 0.0,
-                "triangle {t:?} winds against its normals"
-            );
-            // Convex test shapes: every face looks away from the centre.
-            assert!(face.dot((a + b + c) / 3.0 - centre) > -1e-9);
+            assert!((b - a).cross(c - a).dot((a + b + c) / 3.0 - centre) > -1e-9);
         }
     }
 

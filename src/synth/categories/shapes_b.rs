@@ -161,6 +161,82 @@ pub(super) struct FrontStyle {
     pub thickness: f32,
 }
 
+/// The front panel of thickness `thickness` covering `front` (`[x0, x1, z0, z1]`) just in front of the plane
+/// `y = y_face`, inset by [`GAP`] on every side.
+fn front_panel(
+    front: [f32; 4],
+    y_face: f32,
+    thickness: f32,
+    material: &Material,
+) -> crate::object::RenderMesh {
+    let [x0, x1, z0, z1] = front;
+    let yf = y_face - GAP;
+    slab(
+        Vec3::new(x0 + GAP, yf - thickness, z0 + GAP),
+        Vec3::new(x1 - GAP, yf, z1 - GAP),
+        material,
+    )
+}
+
+/// The moving front of a drawer: a prismatic joint at the centre of `front` (`[x0, x1, z0, z1]`, in front of
+/// the plane `y = y_face`) sliding out along −y by up to `travel`, and its front panel. Returns its link.
+pub(super) fn drawer_front(
+    b: &mut ObjectBuilder,
+    name: &str,
+    front: [f32; 4],
+    y_face: f32,
+    travel: f32,
+    thickness: f32,
+    material: &Material,
+) -> usize {
+    let [x0, x1, z0, z1] = front;
+    let link = b.joint(
+        name,
+        ObjectBuilder::BASE,
+        JointKind::Prismatic,
+        Vec3::new((x0 + x1) * 0.5, y_face, (z0 + z1) * 0.5),
+        Vec3::NEG_Y,
+        0.0,
+        travel,
+    );
+    b.add(link, front_panel(front, y_face, thickness, material));
+    link
+}
+
+/// The leaf of a door covering `front` (`[x0, x1, z0, z1]`, in front of the plane `y = y_face`): a revolute
+/// joint on its left or right front outer edge, so that positive angles (up to `upper`) swing its free edge
+/// out towards −y and it never swings into the carcass, and its front panel. Returns its link.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn door_leaf(
+    b: &mut ObjectBuilder,
+    name: &str,
+    front: [f32; 4],
+    y_face: f32,
+    hinge_left: bool,
+    upper: f32,
+    thickness: f32,
+    material: &Material,
+) -> usize {
+    let [x0, x1, z0, z1] = front;
+    let yf = y_face - GAP;
+    let (hinge_x, axis) = if hinge_left {
+        (x0 + GAP, Vec3::NEG_Z)
+    } else {
+        (x1 - GAP, Vec3::Z)
+    };
+    let link = b.joint(
+        name,
+        ObjectBuilder::BASE,
+        JointKind::Revolute,
+        Vec3::new(hinge_x, yf - thickness, (z0 + z1) * 0.5),
+        axis,
+        0.0,
+        upper,
+    );
+    b.add(link, front_panel(front, y_face, thickness, material));
+    link
+}
+
 /// A drawer whose front covers `front` (`[x0, x1, z0, z1]`, in front of the plane `y = y_face`), with a box
 /// (sides, back, bottom) inside `opening` reaching `depth` behind the face. It slides out along −y by up to
 /// `travel`. Returns its link.
@@ -176,25 +252,17 @@ pub(super) fn drawer(
     style: &FrontStyle,
 ) -> usize {
     let [x0, x1, z0, z1] = front;
-    let link = b.joint(
+    let link = drawer_front(
+        b,
         name,
-        ObjectBuilder::BASE,
-        JointKind::Prismatic,
-        Vec3::new((x0 + x1) * 0.5, y_face, (z0 + z1) * 0.5),
-        Vec3::NEG_Y,
-        0.0,
+        front,
+        y_face,
         travel,
+        style.thickness,
+        &style.front,
     );
     let ft = style.thickness;
     let yf = y_face - GAP;
-    b.add(
-        link,
-        slab(
-            Vec3::new(x0 + GAP, yf - ft, z0 + GAP),
-            Vec3::new(x1 - GAP, yf, z1 - GAP),
-            &style.front,
-        ),
-    );
     // The box clears the opening by a few millimetres so it never touches the carcass.
     let [ox0, ox1, oz0, oz1] = opening;
     let c = 0.004;
@@ -251,29 +319,7 @@ pub(super) fn door(
     let [x0, x1, z0, z1] = front;
     let ft = style.thickness;
     let yf = y_face - GAP;
-    // The hinge runs along the front outer edge, so the door never swings into the carcass.
-    let (hinge_x, axis) = if hinge_left {
-        (x0 + GAP, Vec3::NEG_Z)
-    } else {
-        (x1 - GAP, Vec3::Z)
-    };
-    let link = b.joint(
-        name,
-        ObjectBuilder::BASE,
-        JointKind::Revolute,
-        Vec3::new(hinge_x, yf - ft, (z0 + z1) * 0.5),
-        axis,
-        0.0,
-        upper,
-    );
-    b.add(
-        link,
-        slab(
-            Vec3::new(x0 + GAP, yf - ft, z0 + GAP),
-            Vec3::new(x1 - GAP, yf, z1 - GAP),
-            &style.front,
-        ),
-    );
+    let link = door_leaf(b, name, front, y_face, hinge_left, upper, ft, &style.front);
     let (w, h) = (x1 - x0, z1 - z0);
     let inset = (w * 0.12).min(0.05);
     let free_x = if hinge_left { x1 - inset } else { x0 + inset };

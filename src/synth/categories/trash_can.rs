@@ -35,6 +35,37 @@ fn pedal(b: &mut ObjectBuilder, name: &str, x: f32, front: f32, width: f32, mate
     );
 }
 
+/// A rectangular open-topped body `w` × `d` × `h` standing centred on z = 0, with a dark false floor inside
+/// at height `floor`.
+fn square_body(
+    b: &mut ObjectBuilder,
+    w: f32,
+    d: f32,
+    h: f32,
+    floor: f32,
+    body: &Material,
+    dark: &Material,
+) {
+    let base = ObjectBuilder::BASE;
+    open_box(
+        b,
+        base,
+        Vec3::new(-w / 2.0, -d / 2.0, 0.0),
+        Vec3::new(w / 2.0, d / 2.0, h),
+        0.01,
+        Open::Top,
+        body,
+    );
+    b.add(
+        base,
+        slab(
+            Vec3::new(-w / 2.0 + 0.01, -d / 2.0 + 0.01, floor),
+            Vec3::new(w / 2.0 - 0.01, d / 2.0 - 0.01, floor + 0.003),
+            dark,
+        ),
+    );
+}
+
 /// Builds a trash can with exactly `parts` moving parts.
 pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     let body_mat = random_material(
@@ -116,23 +147,7 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
                 }
             } else {
                 let (w, d) = (rng.uniform(0.25, 0.4), rng.uniform(0.22, 0.35));
-                open_box(
-                    &mut b,
-                    base,
-                    Vec3::new(-w / 2.0, -d / 2.0, 0.0),
-                    Vec3::new(w / 2.0, d / 2.0, top),
-                    0.01,
-                    Open::Top,
-                    &body_mat,
-                );
-                b.add(
-                    base,
-                    slab(
-                        Vec3::new(-w / 2.0 + 0.01, -d / 2.0 + 0.01, top * 0.4),
-                        Vec3::new(w / 2.0 - 0.01, d / 2.0 - 0.01, top * 0.4 + 0.003),
-                        &dark,
-                    ),
-                );
+                square_body(&mut b, w, d, top, top * 0.4, &body_mat, &dark);
                 let lid = b.joint(
                     "lid",
                     base,
@@ -162,23 +177,7 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
                 rng.uniform(0.25, 0.35),
                 rng.uniform(0.4, 0.7),
             );
-            open_box(
-                &mut b,
-                base,
-                Vec3::new(-w / 2.0, -d / 2.0, 0.0),
-                Vec3::new(w / 2.0, d / 2.0, h),
-                0.01,
-                Open::Top,
-                &body_mat,
-            );
-            b.add(
-                base,
-                slab(
-                    Vec3::new(-w / 2.0 + 0.01, -d / 2.0 + 0.01, h * 0.45),
-                    Vec3::new(w / 2.0 - 0.01, d / 2.0 - 0.01, h * 0.45 + 0.003),
-                    &dark,
-                ),
-            );
+            square_body(&mut b, w, d, h, h * 0.45, &body_mat, &dark);
             for (k, left) in [true, false].into_iter().enumerate() {
                 let (x0, x1, hx, axis) = if left {
                     (-w / 2.0, -GAP, -w / 2.0, Vec3::NEG_Y)
