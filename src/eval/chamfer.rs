@@ -48,7 +48,7 @@ pub struct ChamferDistance {
 }
 
 /// Checks a mesh for sampling; returns the cumulative triangle areas (the sampling CDF) and the total area.
-fn area_cdf(mesh: &TriMesh) -> Result<(Vec<f64>, f64), String> {
+pub(crate) fn area_cdf(mesh: &TriMesh) -> Result<(Vec<f64>, f64), String> {
     if mesh.triangles.is_empty() {
         return Err("mesh has no triangles".into());
     }

@@ -15,16 +15,14 @@
 
 use glam::{Affine3A, Vec3};
 
-use super::{
-    GtRenderer, PartMesh, RenderedView, object_bounds, posed_part_meshes, sample_state,
-    sample_views,
-};
+use super::{GtRenderer, PartMesh, RenderedView, posed_part_meshes, sample_state, sample_views};
 use crate::data::{
     Camera, DataError, DatasetWriter, FileSet, Frame, GtJoint, GtMeshes, JointKind as GtKind,
     Split, State, TriMesh, WriteOptions,
 };
+use crate::eval::chamfer::area_cdf;
 use crate::gpu::{GpuContext, GpuError};
-use crate::object::{ArticulatedObject, JointKind};
+use crate::object::{ArticulatedObject, JointKind, mesh_bounds};
 use crate::rng::Rng;
 
 /// Objects whose bounding box diagonal is below this (metres) are refused as having no volume to image.
@@ -156,6 +154,16 @@ pub fn capture_truth(
     obj: &ArticulatedObject,
     states: [Vec<f32>; 2],
 ) -> Result<CaptureTruth, ObjectProblem> {
+    let posed = states.each_ref().map(|q| posed_part_meshes(obj, q));
+    truth_of_posed(obj, states, &posed)
+}
+
+/// [`capture_truth`] for meshes already posed at `states` (the renderer needs them too).
+fn truth_of_posed(
+    obj: &ArticulatedObject,
+    states: [Vec<f32>; 2],
+    posed: &[Vec<PartMesh>; 2],
+) -> Result<CaptureTruth, ObjectProblem> {
     let parts = obj.parts();
     if parts.movable_count() == 0 {
         return Err(ObjectProblem::NothingMoves(obj.name.clone()));
@@ -197,12 +205,12 @@ pub fn capture_truth(
             end: value(1) * scale,
         });
     }
-    let meshes =
-        [0, 1].map(|s| part_meshes(&posed_part_meshes(obj, &states[s]), parts.parts.len()));
+    let meshes = posed.each_ref().map(|p| part_meshes(p, parts.parts.len()));
     // The base may be empty (a door without its frame: there is nothing static to see); every movable part
     // needs a surface, or it could be neither seen nor scored.
     for (k, mesh) in meshes[0].iter().enumerate().skip(1) {
-        if surface_area(mesh) <= 0.0 {
+        // The check the Chamfer sampling applies: what passes here can be scored.
+        if area_cdf(mesh).is_err() {
             let links: Vec<&str> = parts.parts[k]
                 .links
                 .iter()
@@ -244,20 +252,6 @@ fn part_meshes(posed: &[PartMesh], count: usize) -> Vec<TriMesh> {
     out
 }
 
-fn surface_area(mesh: &TriMesh) -> f64 {
-    mesh.triangles
-        .iter()
-        .filter_map(|t| {
-            let p = t.map(|i| mesh.positions.get(i as usize).copied());
-            let [Some(a), Some(b), Some(c)] = p else {
-                return None;
-            };
-            let area = f64::from((b - a).cross(c - a).length()) * 0.5;
-            area.is_finite().then_some(area)
-        })
-        .sum()
-}
-
 /// What [`render_dataset`] produced.
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderedDataset {
@@ -294,23 +288,16 @@ pub async fn render_dataset(
         sample_state(obj, spec.start_range, &mut rng),
         sample_state(obj, spec.end_range, &mut rng),
     ];
-    let truth = capture_truth(obj, states)?;
-    let posed = truth.states.each_ref().map(|q| posed_part_meshes(obj, q));
-    let (lo, hi) = posed
-        .iter()
-        .filter_map(|m| object_bounds(m))
-        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), (a, b)| {
-            (l.min(a), h.max(b))
-        });
+    let posed = states.each_ref().map(|q| posed_part_meshes(obj, q));
+    let truth = truth_of_posed(obj, states, &posed)?;
+    // Framed on both states at once.
+    let (lo, hi) =
+        mesh_bounds(posed.iter().flatten().map(|m| &m.mesh)).unwrap_or((Vec3::ZERO, Vec3::ZERO));
     let size = hi - lo;
-    if !size.is_finite() || size.length() < MIN_OBJECT_SIZE {
+    if size.length() < MIN_OBJECT_SIZE {
         return Err(ObjectProblem::ZeroVolume {
             name: obj.name.clone(),
-            size: if size.is_finite() {
-                size.to_array()
-            } else {
-                [0.0; 3]
-            },
+            size: size.to_array(),
             min: MIN_OBJECT_SIZE,
         }
         .into());

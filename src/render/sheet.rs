@@ -3,10 +3,11 @@
 
 use glam::Vec3;
 
-use super::{GtRenderer, object_bounds, posed_part_meshes};
+use super::{GtRenderer, posed_part_meshes};
 use crate::data::{Camera, RgbaImage, look_at};
 use crate::gpu::{GpuContext, GpuResult};
 use crate::object::ArticulatedObject;
+use crate::object::mesh_bounds;
 
 /// Background of the sheet (light grey, so black and white objects both show).
 const BACKGROUND: [u8; 4] = [230, 230, 230, 255];
@@ -49,15 +50,9 @@ pub async fn contact_sheet(
             .states
             .each_ref()
             .map(|q| posed_part_meshes(entry.object, q));
-        let (lo, hi) = posed
-            .iter()
-            .filter_map(|meshes| object_bounds(meshes))
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), (a, b)| {
-                (l.min(a), h.max(b))
-            });
-        if !lo.is_finite() || !hi.is_finite() {
+        let Some((lo, hi)) = mesh_bounds(posed.iter().flatten().map(|m| &m.mesh)) else {
             continue; // nothing to show
-        }
+        };
         let camera = overview_camera((lo + hi) * 0.5, (hi - lo).length() * 0.5, tile);
         for (side, meshes) in posed.iter().enumerate() {
             let view = renderer.render_view(ctx, meshes, &camera).await?;
