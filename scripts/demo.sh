@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # The README's main-job command. Today: generates the built-in default object (a procedural
-# StorageFurniture cabinet with drawers and doors, seed 7), captures it as a two-state RGB-D dataset
+# StorageFurniture cabinet with three drawers and two doors, seed 4), captures it as a two-state RGB-D dataset
 # with part maps and ground truth, checks the dataset with `artmesh info`, scores the ground truth
 # against itself with `artmesh eval` (all zeros), and runs the GPU self-test. The fit itself joins
 # once the reconstruction and articulation phases land. Usage: scripts/demo.sh [OUTPUT_DIR]
@@ -12,7 +12,7 @@ export XDG_RUNTIME_DIR=${XDG_RUNTIME_DIR:-/tmp/artmesh-xdg-$(id -u)}
 mkdir -p "$XDG_RUNTIME_DIR" && chmod 700 "$XDG_RUNTIME_DIR"
 cargo build --release --bin artmesh
 out=${1:-$(mktemp -d "${TMPDIR:-/tmp}/artmesh-demo.XXXXXX")/cabinet}
-target/release/artmesh synth --category storage --parts 5 --seed 7 --out "$out" \
+target/release/artmesh synth --category storage --parts 5 --seed 4 --out "$out" \
     --width 400 --height 400 --train-views 40 --test-views 8
 target/release/artmesh info "$out"
 target/release/artmesh eval "$out" "$out" --samples 2000 | grep -E '"(axis_ang|axis_pos|part_motion)"' | sort | uniq -c

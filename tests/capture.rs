@@ -208,7 +208,7 @@ fn the_same_seed_gives_the_same_bytes() {
     assert!(a != c, "a different seed gave the same capture");
 }
 
-/// A 1 m box with one door; `edit` changes the builder before the door's joint is added.
+/// A 1 m box with one door of `door_size` on a joint of `kind` with limits `lower..upper`.
 fn door_object(door_size: Vec3, lower: f32, upper: f32, kind: JointKind) -> ArticulatedObject {
     let mat = Material::default();
     let mut b = ObjectBuilder::new("test");
