@@ -9,6 +9,7 @@ pub mod data;
 pub mod eval;
 pub mod gpu;
 pub mod object;
+pub mod raster;
 pub mod render;
 pub mod rng;
 pub mod synth;

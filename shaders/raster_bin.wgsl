@@ -1,0 +1,67 @@
+// Tile binning. `emit_pairs` (one invocation per face) writes a (tile, depth) sort key for every
+// tile the face touches, at the face's scanned offset; after the radix sort, `tile_ranges` (one
+// invocation per sorted pair) records each tile's [start, end) in the sorted list, the face of
+// every sorted slot, and the sorted slot of every emitted pair (so gradients written per sorted
+// slot can be gathered per face without atomics).
+
+@group(0) @binding(0) var<uniform> params: RasterParams;
+@group(0) @binding(1) var<storage, read> records: array<FaceRecord>;
+@group(0) @binding(2) var<storage, read> offsets: array<u32>;        // exclusive scan of tile counts
+@group(0) @binding(3) var<storage, read_write> keys: array<u32>;     // the sorter's keys
+@group(0) @binding(4) var<storage, read_write> values: array<u32>;   // the sorter's values: emission index
+@group(0) @binding(5) var<storage, read_write> pair_face: array<u32>;   // emission index -> face
+@group(0) @binding(6) var<storage, read_write> sorted_face: array<u32>; // sorted slot -> face
+@group(0) @binding(7) var<storage, read_write> pair_slot: array<u32>;   // emission index -> sorted slot
+@group(0) @binding(8) var<storage, read_write> tile_ranges: array<u32>; // 2 per tile: start, end
+
+fn depth_key(depth: f32) -> u32 {
+    let mask = (1u << params.depth_bits) - 1u;
+    let t = clamp((log(max(depth, 1e-30)) - LOG_DEPTH_MIN) / (LOG_DEPTH_MAX - LOG_DEPTH_MIN), 0.0, 1.0);
+    return min(u32(t * f32(mask)), mask);
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn emit_pairs(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let f = workgroup_index(wg) * WG_SIZE + lid;
+    if (f >= params.num_faces) {
+        return;
+    }
+    let rect = records[f].tiles;
+    if (rect.x > rect.z) {
+        return;
+    }
+    let depth = depth_key(records[f].ay.w);
+    var e = offsets[f];
+    for (var ty = rect.y; ty <= rect.w; ty++) {
+        for (var tx = rect.x; tx <= rect.z; tx++) {
+            let tile = ty * params.tiles_x + tx;
+            keys[e] = (tile << params.depth_bits) | depth;
+            values[e] = e;
+            pair_face[e] = f;
+            e++;
+        }
+    }
+}
+
+fn tile_of(j: u32) -> u32 {
+    return keys[j] >> params.depth_bits;
+}
+
+@compute @workgroup_size(WG_SIZE)
+fn find_tile_ranges(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let j = workgroup_index(wg) * WG_SIZE + lid;
+    let n = params.num_pairs;
+    if (j >= n) {
+        return;
+    }
+    let e = values[j];
+    sorted_face[j] = pair_face[e];
+    pair_slot[e] = j;
+    let tile = tile_of(j);
+    if (j == 0u || tile_of(j - 1u) != tile) {
+        tile_ranges[2u * tile] = j;
+    }
+    if (j + 1u == n || tile_of(j + 1u) != tile) {
+        tile_ranges[2u * tile + 1u] = j + 1u;
+    }
+}

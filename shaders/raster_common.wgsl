@@ -1,0 +1,111 @@
+// Structs and helpers shared by the rasterizer's kernel families (prepended after prelude.wgsl by
+// `raster::Rasterizer`). Layouts mirror `RasterParams` and `FaceRecord` in src/raster/kernels.rs.
+//
+// Conventions: pixel coordinates have their origin at the top-left image corner, pixel centres at
+// +0.5; the camera looks down −z (OpenGL); w = −z_camera is the view depth (metres).
+
+const TILE: u32 = 16u;                 // tile side in pixels; one workgroup (256 pixels) per tile
+const MAX_PARTS: u32 = 16u;            // part logits per vertex (K + 1), at most
+const PAIR_GRADS: u32 = 25u;           // per-(face, tile) gradient floats, without part logits
+const CORNER_GRADS: u32 = 8u;          // per-corner gradient floats before the part logits
+const LOG_DEPTH_MIN: f32 = -6.907755;  // ln(1e-3 m): sort keys quantise ln(depth) over [1 mm, 1 km]
+const LOG_DEPTH_MAX: f32 = 6.907755;   // ln(1e3 m)
+
+struct RasterParams {
+    world_to_camera: mat4x4<f32>,
+    camera_position: vec4<f32>,   // xyz: camera centre in world coordinates
+    focal: vec4<f32>,             // fx, fy, cx, cy in pixels
+    background: vec4<f32>,        // rgb composited behind the mesh
+    width: u32,
+    height: u32,
+    tiles_x: u32,
+    tiles_y: u32,
+    num_faces: u32,
+    num_vertices: u32,
+    num_parts: u32,
+    sh_degree: u32,               // active SH degree 0..3
+    gamma: f32,                   // window sharpness exponent
+    opacity_floor: f32,           // face opacity = floor + (1 − floor) · mean vertex opacity
+    alpha_min: f32,               // contributions below this alpha are skipped (1/255; 0 while checking gradients)
+    transmittance_min: f32,       // compositing stops below this transmittance (1e-4; 0 while checking)
+    near: f32,                    // faces with a vertex closer than this are culled
+    depth_bits: u32,              // low bits of a sort key holding the quantised depth
+    num_pairs: u32,               // (face, tile) pairs emitted this view
+    _pad: u32,
+}
+
+// One projected face: everything a pixel needs to evaluate it, in pixel units.
+// Barycentrics are affine in the pixel: λ_i(p) = a_i · (p − s0) + [i == 0].
+struct FaceRecord {
+    ax: vec4<f32>,      // a_i.x (i = 0..2); w: face opacity σ (0 = culled)
+    ay: vec4<f32>,      // a_i.y; w: view depth used for sorting
+    window: vec4<f32>,  // k_i = perimeter / l_i (l_i: length of the edge opposite vertex i)
+    inv_w: vec4<f32>,   // 1 / w_i of the three vertices (perspective-correct interpolation)
+    origin: vec4<f32>,  // xy: projected vertex 0
+    color0: vec4<f32>,  // view-dependent vertex colours (rgb)
+    color1: vec4<f32>,
+    color2: vec4<f32>,
+    verts: vec4<u32>,   // vertex indices
+    tiles: vec4<u32>,   // inclusive tile rectangle x0, y0, x1, y1; x0 > x1 when culled
+}
+
+fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
+    return a.x * b.y - a.y * b.x;
+}
+
+// What a face contributes at a pixel; `alpha` is 0 when it contributes nothing.
+struct Hit {
+    alpha: f32,
+    clamped: bool,      // alpha hit the 0.99 ceiling (no gradient through σφ)
+    lambda: vec3<f32>,  // screen-space barycentrics
+    u: f32,             // min_i λ_i k_i: 1 at the incenter, 0 on the edges
+    edge: u32,          // arg-min of λ_i k_i
+    phi: f32,           // window ReLU(u)^γ
+    mu: vec3<f32>,      // perspective-correct barycentrics
+    z: f32,             // perspective-correct view depth
+    zsum: f32,          // Σ λ_i / w_i (= 1 / z)
+}
+
+// The triangle window of MeshSplatting: φ = ReLU(L(p) / L(s))^γ with L the max of the edge
+// functions and s the incenter, written as (min_i distance to edge i / inradius)^γ
+// = (min_i λ_i · perimeter / l_i)^γ.
+fn evaluate_face(rec: FaceRecord, p: vec2<f32>, params: RasterParams) -> Hit {
+    var hit: Hit;
+    hit.alpha = 0.0;
+    let d = p - rec.origin.xy;
+    let lambda = vec3<f32>(
+        rec.ax.x * d.x + rec.ay.x * d.y + 1.0,
+        rec.ax.y * d.x + rec.ay.y * d.y,
+        rec.ax.z * d.x + rec.ay.z * d.y,
+    );
+    let scaled = lambda * rec.window.xyz;
+    var edge = 0u;
+    var u = scaled.x;
+    if (scaled.y < u) { u = scaled.y; edge = 1u; }
+    if (scaled.z < u) { u = scaled.z; edge = 2u; }
+    if (u <= 0.0) {
+        return hit;
+    }
+    let phi = pow(u, params.gamma);
+    let raw = rec.ax.w * phi;
+    let alpha = min(raw, 0.99);
+    if (alpha < params.alpha_min || alpha <= 0.0) {
+        return hit;
+    }
+    let rho = lambda * rec.inv_w.xyz;
+    let zsum = rho.x + rho.y + rho.z;
+    hit.alpha = alpha;
+    hit.clamped = raw > 0.99;
+    hit.lambda = lambda;
+    hit.u = u;
+    hit.edge = edge;
+    hit.phi = phi;
+    hit.mu = rho / zsum;
+    hit.z = 1.0 / zsum;
+    hit.zsum = zsum;
+    return hit;
+}
+
+fn hit_color(rec: FaceRecord, mu: vec3<f32>) -> vec3<f32> {
+    return mu.x * rec.color0.xyz + mu.y * rec.color1.xyz + mu.z * rec.color2.xyz;
+}

@@ -1,0 +1,20 @@
+//! The differentiable soft mesh rasterizer (MeshSplatting-style, DESIGN.md §4; paper §3.1
+//! "Differentiable mesh rendering"): the mesh field's faces are projected, binned into 16×16
+//! tiles with the GPU radix sort, and alpha-composited front to back with the triangle window
+//! φ = ReLU(L(p)/L(s))^γ; colour, depth and part logits use perspective-correct barycentrics.
+//! The backward pass reaches positions, SH coefficients, opacities and part logits without float
+//! atomics. [`reference`] is a plain CPU renderer of the same model; [`check`] holds the
+//! finite-difference and reference checks run natively and in the browser.
+
+pub mod check;
+mod field;
+mod kernels;
+mod rasterizer;
+pub mod reference;
+
+pub use field::{FieldGradients, GpuField, MeshField, SH_C0, SH_FLOATS, vertex_corners};
+pub use kernels::{MAX_PARTS, TILE};
+pub use rasterizer::{
+    BASE_CHANNELS, ForwardStats, RasterSettings, RasterState, Rasterizer, RenderImages,
+    sort_key_bits,
+};
