@@ -22,7 +22,8 @@
 @group(0) @binding(8) var<storage, read_write> pair_logit_grads: array<f32>;
 
 const BATCH: u32 = 32u;
-var<workgroup> batch: array<FaceRecord, BATCH>;
+var<workgroup> batch: array<FaceGeometry, BATCH>;
+var<workgroup> batch_face: array<u32, BATCH>;
 var<workgroup> acc: array<atomic<u32>, BATCH * PAIR_GRADS>;
 var<workgroup> acc_logits: array<atomic<u32>, BATCH * 3u * MAX_PARTS>;
 var<workgroup> range: vec2<u32>;
@@ -98,20 +99,26 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
     for (var start = r.x; start < r.y; start += BATCH) {
         let j = start + lid;
         if (lid < BATCH && j < r.y) {
-            batch[lid] = records[sorted_face[j]];
+            let f = sorted_face[j];
+            batch_face[lid] = f;
+            batch[lid] = face_geometry(records[f]);
         }
         workgroupBarrier();
         let count = min(BATCH, r.y - start);
-        for (var b = 0u; b < count && !done; b++) {
+        for (var b = 0u; b < count; b++) {
+            // Uniform loop (see raster_composite.wgsl): `done` guards the body instead of breaking.
             if (start + b - r.x >= consumed) {
                 done = true;
-                break;
             }
-            let rec = batch[b];
-            let hit = evaluate_face(rec, p, params);
+            if (done) {
+                continue;
+            }
+            let geom = batch[b];
+            let hit = evaluate_face(geom, p, params);
             if (hit.alpha <= 0.0) {
                 continue;
             }
+            let rec = records[batch_face[b]];
             let mu = hit.mu;
             let w = hit.alpha * transmittance;
             let one_minus = 1.0 - hit.alpha;
@@ -139,17 +146,17 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
             }
             // α = min(0.99, σ φ), φ = u^γ.
             let g_sp = select(g_a, 0.0, hit.clamped);
-            let sigma = rec.ax.w;
+            let sigma = geom.window.w;
             let g_sigma = g_sp * hit.phi;
             let g_u = g_sp * sigma * params.gamma * hit.phi / hit.u;
             let onehot = vec3<f32>(select(0.0, 1.0, hit.edge == 0u), select(0.0, 1.0, hit.edge == 1u), select(0.0, 1.0, hit.edge == 2u));
-            var g_lambda = onehot * g_u * rec.window.xyz;
+            var g_lambda = onehot * g_u * geom.window.xyz;
             let g_k = onehot * g_u * hit.lambda;
             // μ = ρ / Σρ, z = 1 / Σρ, ρ_i = λ_i / w_i.
             let g_rho = (g_mu - dot(g_mu, mu)) / hit.zsum - g_depth * w * hit.z * hit.z;
-            g_lambda += g_rho * rec.inv_w.xyz;
+            g_lambda += g_rho * geom.inv_w.xyz;
             let g_inv_w = g_rho * hit.lambda;
-            let d = p - rec.origin.xy;
+            let d = p - vec2<f32>(geom.geom_x.w, geom.geom_y.w);
             let base = b * PAIR_GRADS;
             add_acc(base + 0u, g_lambda.x * d.x);
             add_acc(base + 1u, g_lambda.y * d.x);

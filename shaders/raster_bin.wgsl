@@ -30,7 +30,7 @@ fn emit_pairs(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     if (rect.x > rect.z) {
         return;
     }
-    let depth = depth_key(records[f].ay.w);
+    let depth = depth_key(records[f].inv_w.w);
     var e = offsets[f];
     for (var ty = rect.y; ty <= rect.w; ty++) {
         for (var tx = rect.x; tx <= rect.z; tx++) {

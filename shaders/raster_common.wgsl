@@ -35,18 +35,31 @@ struct RasterParams {
 }
 
 // One projected face: everything a pixel needs to evaluate it, in pixel units.
-// Barycentrics are affine in the pixel: λ_i(p) = a_i · (p − s0) + [i == 0].
+// Barycentrics are affine in the pixel: λ_i(p) = a_i · (p − s0) + [i == 0]. The first four
+// vectors are what the per-pixel loops stage in workgroup memory (`FaceGeometry`); colours and
+// vertex indices are read from the record only where a face actually covers the pixel.
 struct FaceRecord {
-    ax: vec4<f32>,      // a_i.x (i = 0..2); w: face opacity σ (0 = culled)
-    ay: vec4<f32>,      // a_i.y; w: view depth used for sorting
-    window: vec4<f32>,  // k_i = perimeter / l_i (l_i: length of the edge opposite vertex i)
-    inv_w: vec4<f32>,   // 1 / w_i of the three vertices (perspective-correct interpolation)
-    origin: vec4<f32>,  // xy: projected vertex 0
+    geom_x: vec4<f32>,  // a_i.x (i = 0..2), w: s0.x (projected vertex 0)
+    geom_y: vec4<f32>,  // a_i.y, w: s0.y
+    window: vec4<f32>,  // k_i = perimeter / l_i (l_i: length of the edge opposite vertex i), w: face opacity σ
+    inv_w: vec4<f32>,   // 1 / w_i of the three vertices (perspective-correct weights), w: sort depth
     color0: vec4<f32>,  // view-dependent vertex colours (rgb)
     color1: vec4<f32>,
     color2: vec4<f32>,
     verts: vec4<u32>,   // vertex indices
     tiles: vec4<u32>,   // inclusive tile rectangle x0, y0, x1, y1; x0 > x1 when culled
+}
+
+// The part of a record the coverage test needs.
+struct FaceGeometry {
+    geom_x: vec4<f32>,
+    geom_y: vec4<f32>,
+    window: vec4<f32>,
+    inv_w: vec4<f32>,
+}
+
+fn face_geometry(rec: FaceRecord) -> FaceGeometry {
+    return FaceGeometry(rec.geom_x, rec.geom_y, rec.window, rec.inv_w);
 }
 
 fn cross2(a: vec2<f32>, b: vec2<f32>) -> f32 {
@@ -69,16 +82,16 @@ struct Hit {
 // The triangle window of MeshSplatting: φ = ReLU(L(p) / L(s))^γ with L the max of the edge
 // functions and s the incenter, written as (min_i distance to edge i / inradius)^γ
 // = (min_i λ_i · perimeter / l_i)^γ.
-fn evaluate_face(rec: FaceRecord, p: vec2<f32>, params: RasterParams) -> Hit {
+fn evaluate_face(g: FaceGeometry, p: vec2<f32>, params: RasterParams) -> Hit {
     var hit: Hit;
     hit.alpha = 0.0;
-    let d = p - rec.origin.xy;
+    let d = p - vec2<f32>(g.geom_x.w, g.geom_y.w);
     let lambda = vec3<f32>(
-        rec.ax.x * d.x + rec.ay.x * d.y + 1.0,
-        rec.ax.y * d.x + rec.ay.y * d.y,
-        rec.ax.z * d.x + rec.ay.z * d.y,
+        g.geom_x.x * d.x + g.geom_y.x * d.y + 1.0,
+        g.geom_x.y * d.x + g.geom_y.y * d.y,
+        g.geom_x.z * d.x + g.geom_y.z * d.y,
     );
-    let scaled = lambda * rec.window.xyz;
+    let scaled = lambda * g.window.xyz;
     var edge = 0u;
     var u = scaled.x;
     if (scaled.y < u) { u = scaled.y; edge = 1u; }
@@ -87,12 +100,12 @@ fn evaluate_face(rec: FaceRecord, p: vec2<f32>, params: RasterParams) -> Hit {
         return hit;
     }
     let phi = pow(u, params.gamma);
-    let raw = rec.ax.w * phi;
+    let raw = g.window.w * phi;
     let alpha = min(raw, 0.99);
     if (alpha < params.alpha_min || alpha <= 0.0) {
         return hit;
     }
-    let rho = lambda * rec.inv_w.xyz;
+    let rho = lambda * g.inv_w.xyz;
     let zsum = rho.x + rho.y + rho.z;
     hit.alpha = alpha;
     hit.clamped = raw > 0.99;

@@ -18,9 +18,10 @@
 @group(0) @binding(6) var<storage, read_write> face_stats: array<atomic<u32>>;  // [face]: max weight bits, pixel count
 
 const BATCH: u32 = 64u;
-var<workgroup> batch: array<FaceRecord, BATCH>;
+var<workgroup> batch: array<FaceGeometry, BATCH>;
 var<workgroup> batch_face: array<u32, BATCH>;
 var<workgroup> range: vec2<u32>;
+var<workgroup> finished: atomic<u32>;
 
 @compute @workgroup_size(WG_SIZE)
 fn composite_forward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
@@ -45,41 +46,51 @@ fn composite_forward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     var logits: array<f32, MAX_PARTS>;
     var consumed = 0u;
     var done = !inside;
+    if (done) {
+        atomicAdd(&finished, 1u);
+    }
     for (var start = r.x; start < r.y; start += BATCH) {
         let j = start + lid;
         if (lid < BATCH && j < r.y) {
             let f = sorted_face[j];
             batch_face[lid] = f;
-            batch[lid] = records[f];
+            batch[lid] = face_geometry(records[f]);
         }
         workgroupBarrier();
         let count = min(BATCH, r.y - start);
-        for (var b = 0u; b < count && !done; b++) {
-            let rec = batch[b];
-            let hit = evaluate_face(rec, p, params);
-            if (hit.alpha <= 0.0) {
-                continue;
-            }
-            let w = hit.alpha * transmittance;
-            rgb += w * hit_color(rec, hit.mu);
-            depth += w * hit.z;
-            alpha_sum += w;
-            let v = rec.verts;
-            for (var k = 0u; k < parts; k++) {
-                logits[k] += w * (hit.mu.x * part_logits[v.x * parts + k]
-                    + hit.mu.y * part_logits[v.y * parts + k]
-                    + hit.mu.z * part_logits[v.z * parts + k]);
-            }
-            let f = batch_face[b];
-            atomicMax(&face_stats[2u * f], bitcast<u32>(w));
-            atomicAdd(&face_stats[2u * f + 1u], 1u);
-            transmittance *= 1.0 - hit.alpha;
-            consumed = start + b + 1u - r.x;
-            if (transmittance < params.transmittance_min) {
-                done = true;
+        // The loop stays uniform (no break on `done`): a divergent loop counter would turn the
+        // workgroup-memory reads of `batch[b]` into per-lane gathers on CPU implementations.
+        for (var b = 0u; b < count; b++) {
+            if (!done) {
+                let hit = evaluate_face(batch[b], p, params);
+                if (hit.alpha > 0.0) {
+                    let f = batch_face[b];
+                    let rec = records[f];
+                    let w = hit.alpha * transmittance;
+                    rgb += w * hit_color(rec, hit.mu);
+                    depth += w * hit.z;
+                    alpha_sum += w;
+                    let v = rec.verts;
+                    for (var k = 0u; k < parts; k++) {
+                        logits[k] += w * (hit.mu.x * part_logits[v.x * parts + k]
+                            + hit.mu.y * part_logits[v.y * parts + k]
+                            + hit.mu.z * part_logits[v.z * parts + k]);
+                    }
+                    atomicMax(&face_stats[2u * f], bitcast<u32>(w));
+                    atomicAdd(&face_stats[2u * f + 1u], 1u);
+                    transmittance *= 1.0 - hit.alpha;
+                    consumed = start + b + 1u - r.x;
+                    if (transmittance < params.transmittance_min) {
+                        done = true;
+                        atomicAdd(&finished, 1u);
+                    }
+                }
             }
         }
-        workgroupBarrier();
+        // Stop the whole tile once every pixel is saturated.
+        if (workgroupUniformLoad(&finished) == WG_SIZE) {
+            break;
+        }
     }
     if (!inside) {
         return;

@@ -71,11 +71,10 @@ fn project_faces(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let a0 = vec2<f32>(s[1].y - s[2].y, s[2].x - s[1].x) * inv;
     let a1 = vec2<f32>(s[2].y - s[0].y, s[0].x - s[2].x) * inv;
     let a2 = vec2<f32>(s[0].y - s[1].y, s[1].x - s[0].x) * inv;
-    rec.ax = vec4<f32>(a0.x, a1.x, a2.x, sigma);
-    rec.ay = vec4<f32>(a0.y, a1.y, a2.y, (w.x + w.y + w.z) / 3.0);
-    rec.window = vec4<f32>(perimeter / l, 0.0);
-    rec.inv_w = vec4<f32>(1.0 / w, 0.0);
-    rec.origin = vec4<f32>(s[0], 0.0, 0.0);
+    rec.geom_x = vec4<f32>(a0.x, a1.x, a2.x, s[0].x);
+    rec.geom_y = vec4<f32>(a0.y, a1.y, a2.y, s[0].y);
+    rec.window = vec4<f32>(perimeter / l, sigma);
+    rec.inv_w = vec4<f32>(1.0 / w, (w.x + w.y + w.z) / 3.0);
     rec.color0 = colors[idx.x];
     rec.color1 = colors[idx.y];
     rec.color2 = colors[idx.z];

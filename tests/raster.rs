@@ -39,3 +39,43 @@ fn gradients_match_finite_differences() {
         assert!(failed.is_empty(), "gamma {gamma}: {failed:#?}");
     }
 }
+
+#[test]
+#[ignore]
+fn timing_probe() {
+    use artmesh::raster::{GpuField, RasterState, Rasterizer};
+    let ctx = context();
+    for (faces, size) in [(20_000usize, 128u32), (100_000, 256)] {
+        let scene = check::sphere_scene(faces, size, size, 1);
+        let raster = Rasterizer::new(&ctx);
+        let field = GpuField::upload(&ctx, &scene.field).unwrap();
+        let mut state = RasterState::new(&ctx, size, size, 4).unwrap();
+        state.set_profiling(true);
+        for it in 0..3 {
+            let stats = pollster::block_on(raster.forward(
+                &ctx,
+                &field,
+                &mut state,
+                &scene.camera,
+                &scene.settings,
+            ))
+            .unwrap();
+            let mut enc = ctx.device.create_command_encoder(&Default::default());
+            raster.encode_backward(&ctx, &mut enc, &field, &mut state);
+            ctx.queue.submit([enc.finish()]);
+            ctx.poll_wait().unwrap();
+            let times: Vec<String> = state
+                .clock
+                .take()
+                .iter()
+                .map(|(s, t)| format!("{s} {t:.1}"))
+                .collect();
+            println!(
+                "faces {} size {size} it {it} pairs {}: {}",
+                scene.field.faces.len(),
+                stats.pairs,
+                times.join(", ")
+            );
+        }
+    }
+}

@@ -144,3 +144,21 @@ async fn procedural_object_captures_as_a_dataset_in_the_browser() {
     .unwrap();
     assert_eq!((m.axis_ang, m.part_motion), (Some(0.0), Some(0.0)));
 }
+
+/// The differentiable rasterizer on the browser's adapter: the forward pass against the CPU
+/// reference and the backward pass against finite differences, as `tests/raster.rs` does natively.
+#[wasm_bindgen_test]
+async fn rasterizer_matches_reference_and_finite_differences_in_the_browser() {
+    use artmesh::raster::check;
+    let ctx = context().await;
+    for (seed, gamma) in [(1u64, 1.0f32), (3, 2.0)] {
+        let mut scene = check::scene(seed, 40, 28);
+        scene.settings.gamma = gamma;
+        let report = check::check_reference(&ctx, &scene, 2e-4).await.unwrap();
+        assert!(report.passed(), "{report:#?}");
+    }
+    let scene = check::scene(1, 40, 28);
+    let groups = check::check_gradients(&ctx, &scene, 1, 6).await.unwrap();
+    let failed: Vec<_> = groups.iter().filter(|g| !g.passed()).collect();
+    assert!(failed.is_empty(), "{failed:#?}");
+}

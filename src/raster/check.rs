@@ -238,7 +238,7 @@ pub async fn check_gradients(
     ctx.queue
         .write_buffer(state.grad_render(), 0, bytemuck::cast_slice(&weights));
     let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    raster.encode_backward(ctx, &mut encoder, &field, &state);
+    raster.encode_backward(ctx, &mut encoder, &field, &mut state);
     ctx.queue.submit([encoder.finish()]);
     let grads = field.read_gradients(ctx).await?;
 
@@ -368,4 +368,65 @@ pub async fn check_gradients(
             }
         })
         .collect())
+}
+
+/// A closed, slightly bumpy UV sphere of about `faces` triangles filling the middle of a
+/// `width × height` view: the benchmark scene (random colours, mid-training opacity).
+pub fn sphere_scene(faces: usize, width: u32, height: u32, seed: u64) -> Scene {
+    let mut rng = Rng::new(seed);
+    // 2 · lon · (lat − 1) faces with lon = 2 · lat.
+    let lat = (((faces as f64) / 4.0).sqrt().round() as usize).max(3);
+    let lon = 2 * lat;
+    let mut positions = vec![Vec3::new(0.0, 0.0, 0.5)];
+    for i in 1..lat {
+        let theta = std::f32::consts::PI * i as f32 / lat as f32;
+        for j in 0..lon {
+            let phi = std::f32::consts::TAU * j as f32 / lon as f32;
+            let r = 0.5 * (1.0 + 0.04 * (3.0 * phi).sin() * (5.0 * theta).sin());
+            positions.push(
+                r * Vec3::new(
+                    theta.sin() * phi.cos(),
+                    theta.sin() * phi.sin(),
+                    theta.cos(),
+                ),
+            );
+        }
+    }
+    positions.push(Vec3::new(0.0, 0.0, -0.5));
+    let ring = |i: usize, j: usize| (1 + (i - 1) * lon + j % lon) as u32;
+    let south = (positions.len() - 1) as u32;
+    let mut tris = Vec::new();
+    for j in 0..lon {
+        tris.push([0, ring(1, j), ring(1, j + 1)]);
+        tris.push([south, ring(lat - 1, j + 1), ring(lat - 1, j)]);
+    }
+    for i in 1..lat - 1 {
+        for j in 0..lon {
+            tris.push([ring(i, j), ring(i + 1, j), ring(i + 1, j + 1)]);
+            tris.push([ring(i, j), ring(i + 1, j + 1), ring(i, j + 1)]);
+        }
+    }
+    let mut field = MeshField::new(positions, tris, 4, 0.5);
+    for v in 0..field.num_vertices() {
+        field.set_color(v, Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()));
+        let part = (v * 4 / field.num_vertices()).min(3);
+        field.part_logits[v * 4 + part] = 2.0;
+    }
+    let camera = Camera::from_fov(
+        look_at(Vec3::new(0.0, -2.2, 0.6), Vec3::ZERO, Vec3::Z),
+        width,
+        height,
+        0.6,
+        None,
+    );
+    Scene {
+        field,
+        camera,
+        settings: RasterSettings {
+            gamma: 0.5,
+            background: Vec3::ONE,
+            sh_degree: 0,
+            ..RasterSettings::default()
+        },
+    }
 }

@@ -52,10 +52,10 @@ const _: () = assert!(size_of::<RasterParams>() == 176);
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
 pub struct FaceRecord {
-    pub words: [[f32; 4]; 10],
+    pub words: [[f32; 4]; 9],
 }
 pub const FACE_RECORD_BYTES: u64 = size_of::<FaceRecord>() as u64;
-const _: () = assert!(FACE_RECORD_BYTES == 160);
+const _: () = assert!(FACE_RECORD_BYTES == 144);
 
 /// A kernel family compiled with the rasterizer's shared structs prepended.
 fn family<const N: usize>(

@@ -110,6 +110,49 @@ impl RenderImages {
     }
 }
 
+/// Optional per-stage wall-clock timing (native only; for benchmarks). When enabled, every
+/// stage is submitted and waited for on its own, which serialises the GPU: use it to see where
+/// time goes, not to measure throughput.
+#[derive(Debug, Default)]
+pub struct StageClock {
+    enabled: bool,
+    #[cfg(not(target_arch = "wasm32"))]
+    last: Option<std::time::Instant>,
+    /// (stage, milliseconds) in order, accumulated until [`StageClock::take`].
+    times: Vec<(&'static str, f64)>,
+}
+
+impl StageClock {
+    fn start(&mut self) {
+        #[cfg(not(target_arch = "wasm32"))]
+        if self.enabled {
+            self.last = Some(std::time::Instant::now());
+        }
+    }
+
+    /// Submits what `encoder` holds, waits, and books the time since the last lap on `stage`.
+    fn lap(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, stage: &'static str) {
+        if !self.enabled {
+            return;
+        }
+        let done = std::mem::replace(
+            encoder,
+            ctx.device.create_command_encoder(&Default::default()),
+        );
+        ctx.queue.submit([done.finish()]);
+        let _ = ctx.poll_wait();
+        #[cfg(not(target_arch = "wasm32"))]
+        if let Some(last) = self.last.replace(std::time::Instant::now()) {
+            self.times.push((stage, last.elapsed().as_secs_f64() * 1e3));
+        }
+    }
+
+    /// The stage times booked so far (and clears them).
+    pub fn take(&mut self) -> Vec<(&'static str, f64)> {
+        std::mem::take(&mut self.times)
+    }
+}
+
 /// The rasterizer's compiled kernels (one set per device).
 pub struct Rasterizer {
     sh: ShKernels,
@@ -147,6 +190,8 @@ pub struct RasterState {
     pair_slot: wgpu::Buffer,
     pair_grads: wgpu::Buffer,
     pair_logit_grads: wgpu::Buffer,
+    /// Per-stage timing, off unless [`RasterState::set_profiling`].
+    pub clock: StageClock,
 }
 
 fn f32_bytes(n: u64) -> u64 {
@@ -208,6 +253,7 @@ impl RasterState {
                 "raster.pair_logit_grads",
                 f32_bytes(3 * u64::from(num_parts) * u64::from(pair_capacity)),
             )?,
+            clock: StageClock::default(),
         })
     }
 
@@ -216,6 +262,11 @@ impl RasterState {
             "raster.corner_grads",
             f32_bytes(3 * u64::from(faces) * (CORNER_GRADS + u64::from(parts))),
         )
+    }
+
+    /// Times every stage separately from now on (see [`StageClock`]).
+    pub fn set_profiling(&mut self, enabled: bool) {
+        self.clock.enabled = enabled;
     }
 
     /// Image width and height.
@@ -374,6 +425,7 @@ impl Rasterizer {
 
         // 1. Colours, projection, tile counts and their scan.
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        state.clock.start();
         let sh_bind = self.sh_bind_group(ctx, field, state);
         let vertex_groups = field.num_vertices.div_ceil(256);
         let face_groups = field.num_faces.div_ceil(256);
@@ -383,6 +435,7 @@ impl Rasterizer {
             &sh_bind,
             vertex_groups,
         );
+        state.clock.lap(ctx, &mut encoder, "sh colours");
         let project_bind = self.project.family.bind(
             ctx,
             &[
@@ -403,9 +456,14 @@ impl Rasterizer {
             &project_bind,
             face_groups,
         );
+        state.clock.lap(ctx, &mut encoder, "project");
         state.scan.encode(ctx, &mut encoder, field.num_faces + 1)?;
         ctx.queue.submit([encoder.finish()]);
         let total: Vec<u32> = ctx.read_buffer(state.scan.total(), 1).await?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        state
+            .clock
+            .lap(ctx, &mut encoder, "scan + pair count read-back");
         let pairs = total[0];
         state.ensure_pairs(ctx, pairs)?;
         params.num_pairs = pairs;
@@ -414,7 +472,6 @@ impl Rasterizer {
         state.last_params = params;
 
         // 2. Binning, sort, tile ranges, compositing.
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
         let bin_bind = self.bin_bind_group(ctx, state);
         ctx.dispatch(
             &mut pass(&mut encoder, "raster.emit"),
@@ -422,9 +479,11 @@ impl Rasterizer {
             &bin_bind,
             face_groups,
         );
+        state.clock.lap(ctx, &mut encoder, "emit pairs");
         state
             .sorter
             .encode(ctx, &mut encoder, pairs, tile_bits + depth_bits)?;
+        state.clock.lap(ctx, &mut encoder, "radix sort");
         encoder.clear_buffer(&state.tile_ranges, 0, None);
         ctx.dispatch(
             &mut pass(&mut encoder, "raster.ranges"),
@@ -432,6 +491,7 @@ impl Rasterizer {
             &bin_bind,
             pairs.div_ceil(256),
         );
+        state.clock.lap(ctx, &mut encoder, "tile ranges");
         let composite_bind = self.composite.family.bind(
             ctx,
             &[
@@ -451,6 +511,7 @@ impl Rasterizer {
             &composite_bind,
             tiles,
         );
+        state.clock.lap(ctx, &mut encoder, "composite forward");
         ctx.queue.submit([encoder.finish()]);
         ctx.check()?;
         Ok(ForwardStats {
@@ -466,9 +527,10 @@ impl Rasterizer {
         ctx: &GpuContext,
         encoder: &mut wgpu::CommandEncoder,
         field: &GpuField,
-        state: &RasterState,
+        state: &mut RasterState,
     ) {
         let params = state.last_params;
+        state.clock.start();
         let backward_bind = self.backward.family.bind(
             ctx,
             &[
@@ -490,6 +552,7 @@ impl Rasterizer {
             &backward_bind,
             tiles,
         );
+        state.clock.lap(ctx, encoder, "composite backward");
         let face_bind = self.face_gradients.family.bind(
             ctx,
             &[
@@ -510,6 +573,7 @@ impl Rasterizer {
             &face_bind,
             field.num_faces.div_ceil(256),
         );
+        state.clock.lap(ctx, encoder, "face gradients");
         let vertex_bind = self.vertex_gradients.family.bind(
             ctx,
             &[
@@ -530,6 +594,7 @@ impl Rasterizer {
             &vertex_bind,
             vertex_groups,
         );
+        state.clock.lap(ctx, encoder, "vertex gather");
         let sh_bind = self.sh_bind_group(ctx, field, state);
         ctx.dispatch(
             &mut pass(encoder, "sh.backward"),
@@ -537,6 +602,7 @@ impl Rasterizer {
             &sh_bind,
             vertex_groups,
         );
+        state.clock.lap(ctx, encoder, "sh backward");
     }
 
     fn sh_bind_group(
