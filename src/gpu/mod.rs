@@ -9,6 +9,7 @@
 
 mod buffers;
 mod context;
+mod fma;
 mod kernel;
 mod radix_sort;
 mod scan;
@@ -16,6 +17,8 @@ pub mod selftest;
 
 pub use buffers::binding_chunks;
 pub use context::{AdapterReport, GpuContext, GpuError};
+pub use fma::{FmaPeak, fma_peak, fma_peak_with_clock};
+pub(crate) use kernel::compute_pass;
 pub use kernel::{Binding, KernelFamily};
 pub use radix_sort::{RadixSort, key_mask};
 pub use scan::PrefixSum;
