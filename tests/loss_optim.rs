@@ -226,7 +226,7 @@ fn target_views_split_over_buffers_past_the_binding_limit() {
         pollster::block_on(loss.read_terms(&ctx)).unwrap()
     };
     let mut totals = Vec::new();
-    for view in 0..8 {
+    for (view, target) in views.iter().enumerate() {
         let (a, b) = (eval(&split, view), eval(&whole, view));
         assert_eq!(a, b, "view {view}");
         let expected = artmesh::loss::reference::image_loss(
@@ -234,7 +234,7 @@ fn target_views_split_over_buffers_past_the_binding_limit() {
             H,
             P,
             &scene.render,
-            &views[view],
+            target,
             &LossWeights::default(),
             scene.background,
         )

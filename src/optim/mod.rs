@@ -200,17 +200,20 @@ impl Adam {
         encoder: &mut wgpu::CommandEncoder,
         groups: &mut [&mut AdamGroup],
     ) -> GpuResult<()> {
-        let mut pass = compute_pass(encoder, "adam");
-        for group in groups.iter_mut() {
+        // Validate every group first so an error leaves no group half-stepped.
+        for group in groups.iter() {
             let c = group.config;
-            if !(c.lr.is_finite() && c.eps >= 0.0 && (0.0..1.0).contains(&c.beta1))
-                || !(0.0..1.0).contains(&c.beta2)
-            {
+            let beta_ok = (0.0..1.0).contains(&c.beta1) && (0.0..1.0).contains(&c.beta2);
+            if !(c.lr.is_finite() && c.eps >= 0.0 && beta_ok) {
                 return Err(GpuError::InvalidInput(format!(
                     "{}: Adam needs a finite lr, 0 ≤ β < 1 and ε ≥ 0, got {c:?}",
                     group.label
                 )));
             }
+        }
+        let mut pass = compute_pass(encoder, "adam");
+        for group in groups.iter_mut() {
+            let c = group.config;
             group.step += 1;
             let t = f64::from(group.step);
             let uniform = AdamParams {
@@ -250,7 +253,7 @@ impl Adam {
         map: &[u32],
         stride: u32,
     ) -> GpuResult<()> {
-        if stride == 0 || group.len % stride != 0 {
+        if stride == 0 || !group.len.is_multiple_of(stride) {
             return Err(GpuError::InvalidInput(format!(
                 "{}: remap stride {stride} does not divide the group's {} floats",
                 group.label, group.len
