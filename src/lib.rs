@@ -8,7 +8,9 @@
 pub mod data;
 pub mod eval;
 pub mod gpu;
+pub mod loss;
 pub mod object;
+pub mod optim;
 pub mod raster;
 pub mod render;
 pub mod rng;

@@ -162,3 +162,24 @@ async fn rasterizer_matches_reference_and_finite_differences_in_the_browser() {
     let failed: Vec<_> = groups.iter().filter(|g| !g.passed()).collect();
     assert!(failed.is_empty(), "{failed:#?}");
 }
+
+/// The image loss and Adam on the browser's adapter: central finite differences of every loss term
+/// and the total, the loss against the CPU reference, and Adam against a CPU Adam (decay, remap, reset).
+#[wasm_bindgen_test]
+async fn loss_gradients_and_adam_match_cpu_in_the_browser() {
+    use artmesh::loss::check as loss_check;
+    use artmesh::optim::check as adam_check;
+    let ctx = context().await;
+    let values = loss_check::check_values(&ctx, 0, 23, 17, 3).await.unwrap();
+    assert!(values.passed(), "loss vs CPU reference: {values:#?}");
+    let fd = loss_check::check_gradients(&ctx, 11, 23, 17, 3, 2)
+        .await
+        .unwrap();
+    assert!(
+        fd.passed(),
+        "finite differences disagree: {:#?}",
+        fd.failures()
+    );
+    let adam = adam_check::check_adam(&ctx, 5).await.unwrap();
+    assert!(adam.passed(), "Adam vs CPU: {adam:#?}");
+}

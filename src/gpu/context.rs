@@ -38,6 +38,9 @@ pub enum GpuError {
     /// Mapping a buffer for readback failed.
     #[error("reading results back from the GPU failed: {0}")]
     Readback(String),
+    /// A kernel's inputs do not fit together (sizes, indices, counts); the message says which and how.
+    #[error("{0}")]
+    InvalidInput(String),
 }
 
 impl GpuError {

@@ -2,6 +2,8 @@
 //! ([`GpuContext`]), buffer and readback helpers, the kernel-family wrapper that owns a shader's
 //! pipelines and bind-group layout, and the two data-parallel primitives later stages build on:
 //! an exclusive [`PrefixSum`] and a key–value [`RadixSort`] (the rasterizer's tile binning).
+//! [`fma_peak`] measures the adapter's achievable f32 FMA rate, the denominator of benchmark
+//! efficiency figures.
 //!
 //! Every kernel obeys the portability rules of DESIGN.md §3 so the same WGSL runs on lavapipe,
 //! on SwiftShader inside Chromium, and on real GPUs: ≤ 256 invocations per workgroup, ≤ 8 storage
@@ -9,6 +11,7 @@
 
 mod buffers;
 mod context;
+mod fma;
 mod kernel;
 mod radix_sort;
 mod scan;
@@ -16,6 +19,8 @@ pub mod selftest;
 
 pub use buffers::binding_chunks;
 pub use context::{AdapterReport, GpuContext, GpuError};
+pub use fma::{FmaPeak, fma_peak, fma_peak_with_clock};
+pub(crate) use kernel::compute_pass;
 pub use kernel::{Binding, KernelFamily};
 pub use radix_sort::{RadixSort, key_mask};
 pub use scan::PrefixSum;
