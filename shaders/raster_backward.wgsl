@@ -2,7 +2,9 @@
 // front-to-back order up to the entries the pixel consumed. With O the pixel's final output and
 // P_n the accumulation up to and including face n,
 //   dO/dα_n = q_n T_n − (O − P_n) / (1 − α_n),   dO/dq_n = α_n T_n,
-// so no reverse traversal or division by T is needed. Each pixel's per-face gradient (w.r.t. the
+// so no reverse traversal or division by T is needed. As in the forward pass, each invocation
+// handles 4 pixels of one column; their gradients for a face are summed in registers first. Each
+// pixel's per-face gradient (w.r.t. the
 // face record's barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part
 // logits) is summed over the tile's pixels in workgroup memory (compare-exchange on f32 bits:
 // the browser has no float atomics) and written once per (face, tile) pair, at its sorted slot.
@@ -21,6 +23,7 @@
 @group(0) @binding(7) var<storage, read_write> pair_grads: array<f32>;
 @group(0) @binding(8) var<storage, read_write> pair_logit_grads: array<f32>;
 
+const INVOCATIONS: u32 = 64u;
 const BATCH: u32 = 32u;
 var<workgroup> batch: array<FaceGeometry, BATCH>;
 var<workgroup> batch_face: array<u32, BATCH>;
@@ -56,46 +59,166 @@ fn add_acc_logit(i: u32, v: f32) {
     }
 }
 
-@compute @workgroup_size(WG_SIZE)
+// One pixel's replay state: its final outputs O, their incoming gradients, and the running
+// transmittance and accumulation P_n.
+struct Pixel {
+    p: vec2<f32>,
+    out_rgb: vec3<f32>,
+    out_depth: f32,
+    out_alpha: f32,
+    g_rgb: vec3<f32>,
+    g_depth: f32,
+    g_alpha: f32,
+    out_logits: array<f32, MAX_PARTS>,
+    g_logits: array<f32, MAX_PARTS>,
+    pre_logits: array<f32, MAX_PARTS>,
+    pre_rgb: vec3<f32>,
+    pre_depth: f32,
+    pre_alpha: f32,
+    transmittance: f32,
+    consumed: u32,
+    done: bool,
+}
+
+// One face's gradient summed over an invocation's pixels (layout of PAIR_GRADS, logits aside).
+struct FaceGrad {
+    ax: vec3<f32>,
+    ay: vec3<f32>,
+    lambda: vec3<f32>,
+    k: vec3<f32>,
+    inv_w: vec3<f32>,
+    sigma: f32,
+    color0: vec3<f32>,
+    color1: vec3<f32>,
+    color2: vec3<f32>,
+    hit: bool,
+}
+
+fn start_pixel(px: u32, py: u32) -> Pixel {
+    var s: Pixel;
+    s.p = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
+    s.transmittance = 1.0;
+    s.done = px >= params.width || py >= params.height;
+    if (s.done) {
+        return s;
+    }
+    let parts = params.num_parts;
+    let npix = params.width * params.height;
+    let pix = py * params.width + px;
+    s.out_rgb = vec3<f32>(render[pix], render[npix + pix], render[2u * npix + pix]);
+    s.out_depth = render[3u * npix + pix];
+    s.out_alpha = render[4u * npix + pix];
+    s.g_rgb = vec3<f32>(grad_render[pix], grad_render[npix + pix], grad_render[2u * npix + pix]);
+    s.g_depth = grad_render[3u * npix + pix];
+    s.g_alpha = grad_render[4u * npix + pix];
+    for (var k = 0u; k < parts; k++) {
+        s.out_logits[k] = render[(5u + k) * npix + pix];
+        s.g_logits[k] = grad_render[(5u + k) * npix + pix];
+    }
+    s.consumed = bitcast<u32>(render[(5u + parts) * npix + pix]);
+    return s;
+}
+
+// Replays staged face `b` (list entry `entry`) at pixel `s`, adding its gradient to `fg`.
+fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeometry, b: u32, entry: u32) {
+    if (entry >= (*s).consumed) {
+        (*s).done = true;
+    }
+    if ((*s).done) {
+        return;
+    }
+    let hit = evaluate_face(geom, (*s).p, params);
+    if (hit.alpha <= 0.0) {
+        return;
+    }
+    // Only the fields a hit needs: a whole-record load is 36 per-lane gathers on CPU drivers.
+    let f = batch_face[b];
+    let c0 = records[f].color0.xyz;
+    let c1 = records[f].color1.xyz;
+    let c2 = records[f].color2.xyz;
+    let v = records[f].verts;
+    let parts = params.num_parts;
+    let mu = hit.mu;
+    let t = (*s).transmittance;
+    let w = hit.alpha * t;
+    let one_minus = 1.0 - hit.alpha;
+    let color = mu.x * c0 + mu.y * c1 + mu.z * c2;
+    (*s).pre_rgb += w * color;
+    (*s).pre_depth += w * hit.z;
+    (*s).pre_alpha += w;
+    var g_a = dot((*s).g_rgb, color * t - ((*s).out_rgb - (*s).pre_rgb) / one_minus)
+        + (*s).g_depth * (hit.z * t - ((*s).out_depth - (*s).pre_depth) / one_minus)
+        + (*s).g_alpha * (t - ((*s).out_alpha - (*s).pre_alpha) / one_minus);
+    // dL/dμ_i from colour and logits (depth goes through 1/Σρ below).
+    let gc = (*s).g_rgb * w;
+    var g_mu = vec3<f32>(dot(gc, c0), dot(gc, c1), dot(gc, c2));
+    let logit_base = b * 3u * parts;
+    for (var k = 0u; k < parts; k++) {
+        let sv = vec3<f32>(part_logits[v.x * parts + k], part_logits[v.y * parts + k], part_logits[v.z * parts + k]);
+        let sk = dot(mu, sv);
+        (*s).pre_logits[k] += w * sk;
+        let gk = (*s).g_logits[k];
+        g_a += gk * (sk * t - ((*s).out_logits[k] - (*s).pre_logits[k]) / one_minus);
+        let gs = gk * w;
+        g_mu += gs * sv;
+        add_acc_logit(logit_base + k, mu.x * gs);
+        add_acc_logit(logit_base + parts + k, mu.y * gs);
+        add_acc_logit(logit_base + 2u * parts + k, mu.z * gs);
+    }
+    // α = min(0.99, σ φ), φ = u^γ.
+    let g_sp = select(g_a, 0.0, hit.clamped);
+    let g_u = g_sp * geom.window.w * params.gamma * hit.phi / hit.u;
+    let onehot = vec3<f32>(select(0.0, 1.0, hit.edge == 0u), select(0.0, 1.0, hit.edge == 1u), select(0.0, 1.0, hit.edge == 2u));
+    var g_lambda = onehot * g_u * geom.window.xyz;
+    // μ = ρ / Σρ, z = 1 / Σρ, ρ_i = λ_i / w_i.
+    let g_rho = (g_mu - dot(g_mu, mu)) / hit.zsum - (*s).g_depth * w * hit.z * hit.z;
+    g_lambda += g_rho * geom.inv_w.xyz;
+    let d = (*s).p - vec2<f32>(geom.geom_x.w, geom.geom_y.w);
+    (*fg).ax += g_lambda * d.x;
+    (*fg).ay += g_lambda * d.y;
+    (*fg).lambda += g_lambda;
+    (*fg).k += onehot * g_u * hit.lambda;
+    (*fg).inv_w += g_rho * hit.lambda;
+    (*fg).sigma += g_sp * hit.phi;
+    (*fg).color0 += mu.x * gc;
+    (*fg).color1 += mu.y * gc;
+    (*fg).color2 += mu.z * gc;
+    (*fg).hit = true;
+    (*s).transmittance *= one_minus;
+}
+
+fn flush(fg: FaceGrad, b: u32) {
+    let base = b * PAIR_GRADS;
+    for (var i = 0u; i < 3u; i++) {
+        add_acc(base + i, fg.ax[i]);
+        add_acc(base + 3u + i, fg.ay[i]);
+        add_acc(base + 6u + i, fg.lambda[i]);
+        add_acc(base + 9u + i, fg.k[i]);
+        add_acc(base + 12u + i, fg.inv_w[i]);
+        add_acc(base + 16u + i, fg.color0[i]);
+        add_acc(base + 19u + i, fg.color1[i]);
+        add_acc(base + 22u + i, fg.color2[i]);
+    }
+    add_acc(base + 15u, fg.sigma);
+}
+
+@compute @workgroup_size(INVOCATIONS)
 fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let tile = workgroup_index(wg);
     if (tile >= params.tiles_x * params.tiles_y) {
         return;
     }
     let px = (tile % params.tiles_x) * TILE + lid % TILE;
-    let py = (tile / params.tiles_x) * TILE + lid / TILE;
-    let inside = px < params.width && py < params.height;
-    let p = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
+    let py = (tile / params.tiles_x) * TILE + (lid / TILE) * 4u;
     if (lid == 0u) {
         range = vec2<u32>(tile_ranges[2u * tile], tile_ranges[2u * tile + 1u]);
     }
+    var s0 = start_pixel(px, py);
+    var s1 = start_pixel(px, py + 1u);
+    var s2 = start_pixel(px, py + 2u);
+    var s3 = start_pixel(px, py + 3u);
     let r = workgroupUniformLoad(&range);
-    let parts = params.num_parts;
-    let npix = params.width * params.height;
-    let pix = min(py * params.width + px, npix - 1u);
-
-    // Final outputs and their incoming gradients.
-    let out_rgb = vec3<f32>(render[pix], render[npix + pix], render[2u * npix + pix]);
-    let out_depth = render[3u * npix + pix];
-    let out_alpha = render[4u * npix + pix];
-    let g_rgb = vec3<f32>(grad_render[pix], grad_render[npix + pix], grad_render[2u * npix + pix]);
-    let g_depth = grad_render[3u * npix + pix];
-    let g_alpha_out = grad_render[4u * npix + pix];
-    var out_logits: array<f32, MAX_PARTS>;
-    var g_logits: array<f32, MAX_PARTS>;
-    for (var k = 0u; k < parts; k++) {
-        out_logits[k] = render[(5u + k) * npix + pix];
-        g_logits[k] = grad_render[(5u + k) * npix + pix];
-    }
-    let consumed = bitcast<u32>(render[(5u + parts) * npix + pix]);
-
-    var transmittance = 1.0;
-    var pre_rgb = vec3<f32>(0.0);
-    var pre_depth = 0.0;
-    var pre_alpha = 0.0;
-    var pre_logits: array<f32, MAX_PARTS>;
-    var done = !inside;
-    let logit_stride = 3u * parts;
+    let logit_stride = 3u * params.num_parts;
     for (var start = r.x; start < r.y; start += BATCH) {
         let j = start + lid;
         if (lid < BATCH && j < r.y) {
@@ -105,88 +228,25 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
         }
         workgroupBarrier();
         let count = min(BATCH, r.y - start);
+        // Uniform loop (see raster_composite.wgsl).
         for (var b = 0u; b < count; b++) {
-            // Uniform loop (see raster_composite.wgsl): `done` guards the body instead of breaking.
-            if (start + b - r.x >= consumed) {
-                done = true;
-            }
-            if (done) {
-                continue;
-            }
             let geom = batch[b];
-            let hit = evaluate_face(geom, p, params);
-            if (hit.alpha <= 0.0) {
-                continue;
+            let entry = start + b - r.x;
+            var fg: FaceGrad;
+            backprop(&s0, &fg, geom, b, entry);
+            backprop(&s1, &fg, geom, b, entry);
+            backprop(&s2, &fg, geom, b, entry);
+            backprop(&s3, &fg, geom, b, entry);
+            if (fg.hit) {
+                flush(fg, b);
             }
-            let rec = records[batch_face[b]];
-            let mu = hit.mu;
-            let w = hit.alpha * transmittance;
-            let one_minus = 1.0 - hit.alpha;
-            let color = hit_color(rec, mu);
-            pre_rgb += w * color;
-            pre_depth += w * hit.z;
-            pre_alpha += w;
-            var g_a = dot(g_rgb, color * transmittance - (out_rgb - pre_rgb) / one_minus)
-                + g_depth * (hit.z * transmittance - (out_depth - pre_depth) / one_minus)
-                + g_alpha_out * (transmittance - (out_alpha - pre_alpha) / one_minus);
-            // dL/dμ_i from colour and logits (depth goes through 1/Σρ below).
-            let gc = g_rgb * w;
-            var g_mu = vec3<f32>(dot(gc, rec.color0.xyz), dot(gc, rec.color1.xyz), dot(gc, rec.color2.xyz));
-            let v = rec.verts;
-            for (var k = 0u; k < parts; k++) {
-                let s = vec3<f32>(part_logits[v.x * parts + k], part_logits[v.y * parts + k], part_logits[v.z * parts + k]);
-                let sk = dot(mu, s);
-                pre_logits[k] += w * sk;
-                g_a += g_logits[k] * (sk * transmittance - (out_logits[k] - pre_logits[k]) / one_minus);
-                let gs = g_logits[k] * w;
-                g_mu += gs * s;
-                add_acc_logit(b * logit_stride + k, mu.x * gs);
-                add_acc_logit(b * logit_stride + parts + k, mu.y * gs);
-                add_acc_logit(b * logit_stride + 2u * parts + k, mu.z * gs);
-            }
-            // α = min(0.99, σ φ), φ = u^γ.
-            let g_sp = select(g_a, 0.0, hit.clamped);
-            let sigma = geom.window.w;
-            let g_sigma = g_sp * hit.phi;
-            let g_u = g_sp * sigma * params.gamma * hit.phi / hit.u;
-            let onehot = vec3<f32>(select(0.0, 1.0, hit.edge == 0u), select(0.0, 1.0, hit.edge == 1u), select(0.0, 1.0, hit.edge == 2u));
-            var g_lambda = onehot * g_u * geom.window.xyz;
-            let g_k = onehot * g_u * hit.lambda;
-            // μ = ρ / Σρ, z = 1 / Σρ, ρ_i = λ_i / w_i.
-            let g_rho = (g_mu - dot(g_mu, mu)) / hit.zsum - g_depth * w * hit.z * hit.z;
-            g_lambda += g_rho * geom.inv_w.xyz;
-            let g_inv_w = g_rho * hit.lambda;
-            let d = p - vec2<f32>(geom.geom_x.w, geom.geom_y.w);
-            let base = b * PAIR_GRADS;
-            add_acc(base + 0u, g_lambda.x * d.x);
-            add_acc(base + 1u, g_lambda.y * d.x);
-            add_acc(base + 2u, g_lambda.z * d.x);
-            add_acc(base + 3u, g_lambda.x * d.y);
-            add_acc(base + 4u, g_lambda.y * d.y);
-            add_acc(base + 5u, g_lambda.z * d.y);
-            add_acc(base + 6u, g_lambda.x);
-            add_acc(base + 7u, g_lambda.y);
-            add_acc(base + 8u, g_lambda.z);
-            add_acc(base + 9u, g_k.x);
-            add_acc(base + 10u, g_k.y);
-            add_acc(base + 11u, g_k.z);
-            add_acc(base + 12u, g_inv_w.x);
-            add_acc(base + 13u, g_inv_w.y);
-            add_acc(base + 14u, g_inv_w.z);
-            add_acc(base + 15u, g_sigma);
-            for (var c = 0u; c < 3u; c++) {
-                add_acc(base + 16u + c, mu.x * gc[c]);
-                add_acc(base + 19u + c, mu.y * gc[c]);
-                add_acc(base + 22u + c, mu.z * gc[c]);
-            }
-            transmittance *= one_minus;
         }
         workgroupBarrier();
-        // Flush this batch's sums (and zero them for the next batch).
-        for (var i = lid; i < count * PAIR_GRADS; i += WG_SIZE) {
+        // Write this batch's sums (and zero them for the next batch).
+        for (var i = lid; i < count * PAIR_GRADS; i += INVOCATIONS) {
             pair_grads[start * PAIR_GRADS + i] = bitcast<f32>(atomicExchange(&acc[i], 0u));
         }
-        for (var i = lid; i < count * logit_stride; i += WG_SIZE) {
+        for (var i = lid; i < count * logit_stride; i += INVOCATIONS) {
             pair_logit_grads[start * logit_stride + i] = bitcast<f32>(atomicExchange(&acc_logits[i], 0u));
         }
     }

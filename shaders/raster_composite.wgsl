@@ -1,7 +1,11 @@
-// Forward compositing: one workgroup per 16×16 tile, one invocation per pixel. Faces of the tile
-// arrive depth-sorted (front to back) and are staged in workgroup memory in batches; each pixel
-// composites α_n = min(0.99, σ_n φ_n(p)) with colour, depth and part logits interpolated by
+// Forward compositing: one workgroup per 16×16 tile. Faces of the tile arrive depth-sorted
+// (front to back) and are staged in workgroup memory in batches; each pixel composites
+// α_n = min(0.99, σ_n φ_n(p)) with colour, depth and part logits interpolated by
 // perspective-correct barycentrics, skipping α < alpha_min and stopping once T < transmittance_min.
+//
+// Each invocation shades PIXELS = 4 pixels of one column (rows 4r .. 4r+3): a staged face is read
+// from workgroup memory once for four pixels. CPU drivers (lavapipe, SwiftShader) turn every
+// workgroup-memory read into a per-lane gather, which made that read the dominant cost.
 //
 // Output planes (planar f32, plane c at c · width · height): 0–2 RGB over the background,
 // 3 expected depth Σ w z, 4 accumulated alpha Σ w, 5.. part logits Σ w s, and after the P logit
@@ -17,94 +21,141 @@
 @group(0) @binding(5) var<storage, read_write> render: array<f32>;
 @group(0) @binding(6) var<storage, read_write> face_stats: array<atomic<u32>>;  // [face]: max weight bits, pixel count
 
+const PIXELS: u32 = 8u;                  // pixels per invocation, rows of one column
+const INVOCATIONS: u32 = TILE * TILE / PIXELS;
 const BATCH: u32 = 64u;
 var<workgroup> batch: array<FaceGeometry, BATCH>;
 var<workgroup> batch_face: array<u32, BATCH>;
 var<workgroup> range: vec2<u32>;
 var<workgroup> finished: atomic<u32>;
 
-@compute @workgroup_size(WG_SIZE)
+struct Pixel {
+    p: vec2<f32>,
+    transmittance: f32,
+    rgb: vec3<f32>,
+    depth: f32,
+    alpha: f32,
+    consumed: u32,
+    done: bool,
+    logits: array<f32, MAX_PARTS>,
+}
+
+fn start_pixel(px: u32, py: u32) -> Pixel {
+    var s: Pixel;
+    s.p = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
+    s.transmittance = 1.0;
+    s.done = px >= params.width || py >= params.height;
+    if (s.done) {
+        atomicAdd(&finished, 1u);
+    }
+    return s;
+}
+
+// Composites staged face `b` (list entry `entry`) over pixel `s`.
+fn shade(s: ptr<function, Pixel>, g: FaceGeometry, b: u32, entry: u32) {
+    if ((*s).done) {
+        return;
+    }
+    let hit = evaluate_face(g, (*s).p, params);
+    if (hit.alpha <= 0.0) {
+        return;
+    }
+    let f = batch_face[b];
+    // Only the fields a hit needs: a whole-record load is 36 per-lane gathers on CPU drivers.
+    let c0 = records[f].color0.xyz;
+    let c1 = records[f].color1.xyz;
+    let c2 = records[f].color2.xyz;
+    let v = records[f].verts;
+    let parts = params.num_parts;
+    let w = hit.alpha * (*s).transmittance;
+    (*s).rgb += w * (hit.mu.x * c0 + hit.mu.y * c1 + hit.mu.z * c2);
+    (*s).depth += w * hit.z;
+    (*s).alpha += w;
+    for (var k = 0u; k < parts; k++) {
+        (*s).logits[k] += w * (hit.mu.x * part_logits[v.x * parts + k]
+            + hit.mu.y * part_logits[v.y * parts + k]
+            + hit.mu.z * part_logits[v.z * parts + k]);
+    }
+    atomicMax(&face_stats[2u * f], bitcast<u32>(w));
+    atomicAdd(&face_stats[2u * f + 1u], 1u);
+    (*s).transmittance *= 1.0 - hit.alpha;
+    (*s).consumed = entry + 1u;
+    if ((*s).transmittance < params.transmittance_min) {
+        (*s).done = true;
+        atomicAdd(&finished, 1u);
+    }
+}
+
+fn write_pixel(s: Pixel, px: u32, py: u32) {
+    if (px >= params.width || py >= params.height) {
+        return;
+    }
+    let npix = params.width * params.height;
+    let pix = py * params.width + px;
+    let color = s.rgb + s.transmittance * params.background.xyz;
+    render[pix] = color.x;
+    render[npix + pix] = color.y;
+    render[2u * npix + pix] = color.z;
+    render[3u * npix + pix] = s.depth;
+    render[4u * npix + pix] = s.alpha;
+    for (var k = 0u; k < params.num_parts; k++) {
+        render[(5u + k) * npix + pix] = s.logits[k];
+    }
+    render[(5u + params.num_parts) * npix + pix] = bitcast<f32>(s.consumed);
+}
+
+@compute @workgroup_size(INVOCATIONS)
 fn composite_forward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let tile = workgroup_index(wg);
     if (tile >= params.tiles_x * params.tiles_y) {
         return;
     }
     let px = (tile % params.tiles_x) * TILE + lid % TILE;
-    let py = (tile / params.tiles_x) * TILE + lid / TILE;
-    let inside = px < params.width && py < params.height;
-    let p = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
+    let py = (tile / params.tiles_x) * TILE + (lid / TILE) * PIXELS;
     if (lid == 0u) {
         range = vec2<u32>(tile_ranges[2u * tile], tile_ranges[2u * tile + 1u]);
     }
+    var s0 = start_pixel(px, py + 0u);
+    var s1 = start_pixel(px, py + 1u);
+    var s2 = start_pixel(px, py + 2u);
+    var s3 = start_pixel(px, py + 3u);
+    var s4 = start_pixel(px, py + 4u);
+    var s5 = start_pixel(px, py + 5u);
+    var s6 = start_pixel(px, py + 6u);
+    var s7 = start_pixel(px, py + 7u);
     let r = workgroupUniformLoad(&range);
-    let parts = params.num_parts;
-
-    var transmittance = 1.0;
-    var rgb = vec3<f32>(0.0);
-    var depth = 0.0;
-    var alpha_sum = 0.0;
-    var logits: array<f32, MAX_PARTS>;
-    var consumed = 0u;
-    var done = !inside;
-    if (done) {
-        atomicAdd(&finished, 1u);
-    }
     for (var start = r.x; start < r.y; start += BATCH) {
-        let j = start + lid;
-        if (lid < BATCH && j < r.y) {
-            let f = sorted_face[j];
-            batch_face[lid] = f;
-            batch[lid] = face_geometry(records[f]);
+        for (var i = lid; i < BATCH && start + i < r.y; i += INVOCATIONS) {
+            let f = sorted_face[start + i];
+            batch_face[i] = f;
+            batch[i] = face_geometry(records[f]);
         }
         workgroupBarrier();
+        // A uniform loop (no break on `done`): a divergent counter would make `batch[b]` a gather.
         let count = min(BATCH, r.y - start);
-        // The loop stays uniform (no break on `done`): a divergent loop counter would turn the
-        // workgroup-memory reads of `batch[b]` into per-lane gathers on CPU implementations.
         for (var b = 0u; b < count; b++) {
-            if (!done) {
-                let hit = evaluate_face(batch[b], p, params);
-                if (hit.alpha > 0.0) {
-                    let f = batch_face[b];
-                    let rec = records[f];
-                    let w = hit.alpha * transmittance;
-                    rgb += w * hit_color(rec, hit.mu);
-                    depth += w * hit.z;
-                    alpha_sum += w;
-                    let v = rec.verts;
-                    for (var k = 0u; k < parts; k++) {
-                        logits[k] += w * (hit.mu.x * part_logits[v.x * parts + k]
-                            + hit.mu.y * part_logits[v.y * parts + k]
-                            + hit.mu.z * part_logits[v.z * parts + k]);
-                    }
-                    atomicMax(&face_stats[2u * f], bitcast<u32>(w));
-                    atomicAdd(&face_stats[2u * f + 1u], 1u);
-                    transmittance *= 1.0 - hit.alpha;
-                    consumed = start + b + 1u - r.x;
-                    if (transmittance < params.transmittance_min) {
-                        done = true;
-                        atomicAdd(&finished, 1u);
-                    }
-                }
-            }
+            let g = batch[b];
+            let entry = start + b - r.x;
+            shade(&s0, g, b, entry);
+            shade(&s1, g, b, entry);
+            shade(&s2, g, b, entry);
+            shade(&s3, g, b, entry);
+            shade(&s4, g, b, entry);
+            shade(&s5, g, b, entry);
+            shade(&s6, g, b, entry);
+            shade(&s7, g, b, entry);
         }
         // Stop the whole tile once every pixel is saturated.
-        if (workgroupUniformLoad(&finished) == WG_SIZE) {
+        if (workgroupUniformLoad(&finished) == TILE * TILE) {
             break;
         }
     }
-    if (!inside) {
-        return;
-    }
-    let npix = params.width * params.height;
-    let pix = py * params.width + px;
-    let color = rgb + transmittance * params.background.xyz;
-    render[pix] = color.x;
-    render[npix + pix] = color.y;
-    render[2u * npix + pix] = color.z;
-    render[3u * npix + pix] = depth;
-    render[4u * npix + pix] = alpha_sum;
-    for (var k = 0u; k < parts; k++) {
-        render[(5u + k) * npix + pix] = logits[k];
-    }
-    render[(5u + parts) * npix + pix] = bitcast<f32>(consumed);
+    write_pixel(s0, px, py + 0u);
+    write_pixel(s1, px, py + 1u);
+    write_pixel(s2, px, py + 2u);
+    write_pixel(s3, px, py + 3u);
+    write_pixel(s4, px, py + 4u);
+    write_pixel(s5, px, py + 5u);
+    write_pixel(s6, px, py + 6u);
+    write_pixel(s7, px, py + 7u);
 }
