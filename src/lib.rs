@@ -7,6 +7,7 @@
 
 pub mod data;
 pub mod eval;
+pub mod fit;
 pub mod gpu;
 pub mod loss;
 pub mod object;

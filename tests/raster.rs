@@ -41,41 +41,66 @@ fn gradients_match_finite_differences() {
 }
 
 #[test]
-#[ignore]
-fn timing_probe() {
-    use artmesh::raster::{GpuField, RasterState, Rasterizer};
+fn buffer_limits_give_clear_errors() {
+    use artmesh::gpu::GpuError;
+    use artmesh::raster::{GpuField, MeshField, RasterState, Rasterizer};
     let ctx = context();
-    for (faces, size) in [(20_000usize, 128u32), (100_000, 256)] {
-        let scene = check::sphere_scene(faces, size, size, 1);
-        let raster = Rasterizer::new(&ctx);
+    // A 20000² render needs (5 + 1 + 1) planes of 1.6 GB: more than one storage binding.
+    let err = RasterState::new(&ctx, 20_000, 20_000, 1)
+        .err()
+        .expect("a 20000² render must be refused");
+    assert!(
+        matches!(&err, GpuError::BindingTooLarge { what, .. } if what.contains("render")),
+        "{err}"
+    );
+    // A million faces need 144 MB of face records, over lavapipe's 128 MiB binding limit.
+    let limit = ctx.limits.max_storage_buffer_binding_size;
+    let faces = (limit / 144 + 1000) as usize;
+    if faces <= 4_000_000 {
+        let mut scene = check::scene(1, 32, 32);
+        let f = scene.field.faces[0];
+        scene.field.faces = vec![f; faces];
         let field = GpuField::upload(&ctx, &scene.field).unwrap();
-        let mut state = RasterState::new(&ctx, size, size, 4).unwrap();
-        state.set_profiling(true);
-        for it in 0..3 {
-            let stats = pollster::block_on(raster.forward(
-                &ctx,
-                &field,
-                &mut state,
-                &scene.camera,
-                &scene.settings,
-            ))
-            .unwrap();
-            let mut enc = ctx.device.create_command_encoder(&Default::default());
-            raster.encode_backward(&ctx, &mut enc, &field, &mut state);
-            ctx.queue.submit([enc.finish()]);
-            ctx.poll_wait().unwrap();
-            let times: Vec<String> = state
-                .clock
-                .take()
-                .iter()
-                .map(|(s, t)| format!("{s} {t:.1}"))
-                .collect();
-            println!(
-                "faces {} size {size} it {it} pairs {}: {}",
-                scene.field.faces.len(),
-                stats.pairs,
-                times.join(", ")
-            );
-        }
+        let mut state = RasterState::new(&ctx, 32, 32, scene.field.num_parts as u32).unwrap();
+        let raster = Rasterizer::new(&ctx);
+        let err = pollster::block_on(raster.forward(
+            &ctx,
+            &field,
+            &mut state,
+            &scene.camera,
+            &scene.settings,
+        ))
+        .expect_err("too many faces for one binding must be refused");
+        assert!(
+            matches!(&err, GpuError::BindingTooLarge { what, .. } if what.contains("face records")),
+            "{err}"
+        );
+        ctx.check().expect("no device error after a refused render");
     }
+    // Inconsistent inputs name the problem.
+    let mut bad = MeshField::new(vec![glam::Vec3::ZERO; 3], vec![[0, 1, 5]], 2, 0.0);
+    let err = GpuField::upload(&ctx, &bad).err().unwrap();
+    assert!(err.to_string().contains("face 0"), "{err}");
+    bad.faces = vec![[0, 1, 2]];
+    bad.num_parts = 17;
+    assert!(
+        GpuField::upload(&ctx, &bad)
+            .err()
+            .unwrap()
+            .to_string()
+            .contains("num_parts")
+    );
+    let scene = check::scene(1, 40, 28);
+    let field = GpuField::upload(&ctx, &scene.field).unwrap();
+    let mut state = RasterState::new(&ctx, 20, 20, 3).unwrap();
+    let err = pollster::block_on(Rasterizer::new(&ctx).forward(
+        &ctx,
+        &field,
+        &mut state,
+        &scene.camera,
+        &scene.settings,
+    ))
+    .err()
+    .unwrap();
+    assert!(err.to_string().contains("40x28"), "{err}");
 }

@@ -183,3 +183,24 @@ async fn loss_gradients_and_adam_match_cpu_in_the_browser() {
     let adam = adam_check::check_adam(&ctx, 5).await.unwrap();
     assert!(adam.passed(), "Adam vs CPU: {adam:#?}");
 }
+
+/// The photometric driver's short fit (the same as `tests/fit_photometric.rs`) on the browser's
+/// adapter: capture, rasterizer, loss and Adam together must raise the training PSNR.
+#[wasm_bindgen_test]
+async fn a_short_photometric_fit_learns_in_the_browser() {
+    use artmesh::fit::photometric;
+    let ctx = context().await;
+    let (spec, config) = photometric::short_fit();
+    let problem = photometric::synthetic_scene(&ctx, &spec).await.unwrap();
+    let result = photometric::fit(&ctx, &problem, &config, &mut |_| {})
+        .await
+        .unwrap();
+    let first = result.curve.first().unwrap().loss.total;
+    let last = result.curve.last().unwrap().loss.total;
+    assert!(
+        result.psnr_end > result.psnr_start + 3.0 && last < 0.7 * first,
+        "PSNR {} -> {}, loss {first} -> {last}",
+        result.psnr_start,
+        result.psnr_end
+    );
+}

@@ -218,6 +218,16 @@ mod cli {
             #[arg(long, default_value_t = 10)]
             views: usize,
         },
+        /// Rasterizer training iterations (forward + loss + backward + Adam) on a benchmark mesh:
+        /// ms per iteration, pixel-face evaluations/s, model FLOP rate against an FMA peak probe.
+        Raster {
+            /// Cases as SIZExFACES (square image side, target face count).
+            #[arg(long, value_delimiter = ',', default_values_t = ["128x20000".to_string(), "256x100000".to_string(), "800x300000".to_string()])]
+            cases: Vec<String>,
+            /// Timed iterations per case (after one warm-up iteration).
+            #[arg(long, default_value_t = 3)]
+            repeats: usize,
+        },
         /// Radix-sort throughput (keys/s) on the current adapter.
         Sort {
             /// Key counts to time.
@@ -350,6 +360,29 @@ mod cli {
             } => {
                 let ctx = context()?;
                 let report = artmesh::bench::capture(&ctx, &sizes, views)?;
+                out!("{}", to_json(&report)?);
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Bench {
+                which: Bench::Raster { cases, repeats },
+            } => {
+                let cases = cases
+                    .iter()
+                    .map(|c| {
+                        let parsed = c.split_once('x').and_then(|(s, f)| {
+                            Some((s.parse::<u32>().ok()?, f.parse::<usize>().ok()?))
+                        });
+                        match parsed {
+                            Some((size, faces)) if size > 0 && faces > 0 => Ok((size, faces)),
+                            _ => Err(format!(
+                                "--cases: expected SIZExFACES such as 128x20000, found '{c}'"
+                            )),
+                        }
+                    })
+                    .collect::<Result<Vec<_>, _>>()?;
+                let ctx = context()?;
+                let report = artmesh::bench::raster(&ctx, &cases, repeats.max(1))
+                    .map_err(|e| e.to_string())?;
                 out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }

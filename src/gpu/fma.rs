@@ -50,18 +50,7 @@ pub struct FmaPeak {
 
 /// Measures the adapter's achievable f32 FMA rate with the platform clock.
 pub async fn fma_peak(ctx: &GpuContext) -> GpuResult<FmaPeak> {
-    #[cfg(not(target_arch = "wasm32"))]
-    let clock = {
-        let origin = std::time::Instant::now();
-        move || origin.elapsed().as_secs_f64()
-    };
-    #[cfg(target_arch = "wasm32")]
-    let clock = || {
-        web_sys::window()
-            .and_then(|w| w.performance())
-            .map_or(0.0, |p| p.now() / 1000.0)
-    };
-    fma_peak_with_clock(ctx, &clock).await
+    fma_peak_with_clock(ctx, &super::now_seconds).await
 }
 
 /// [`fma_peak`] with a caller's clock (seconds, monotonic).

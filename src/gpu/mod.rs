@@ -10,6 +10,7 @@
 //! buffers per stage, no float atomics, dispatches tiled in 2-D past the per-dimension limit.
 
 mod buffers;
+mod clock;
 mod context;
 mod fma;
 mod kernel;
@@ -18,6 +19,7 @@ mod scan;
 pub mod selftest;
 
 pub use buffers::binding_chunks;
+pub use clock::now_seconds;
 pub use context::{AdapterReport, GpuContext, GpuError};
 pub use fma::{FmaPeak, fma_peak, fma_peak_with_clock};
 pub(crate) use kernel::compute_pass;

@@ -134,7 +134,7 @@ impl GpuField {
     pub fn upload(ctx: &GpuContext, field: &MeshField) -> GpuResult<Self> {
         field
             .validate()
-            .map_err(|e| GpuError::Device(format!("invalid mesh field: {e}")))?;
+            .map_err(|e| GpuError::InvalidInput(format!("invalid mesh field: {e}")))?;
         let n = field.num_vertices();
         let too_many = |what: &str, count: usize| GpuError::TooManyElements {
             what: what.to_string(),

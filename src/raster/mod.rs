@@ -15,6 +15,6 @@ pub mod reference;
 pub use field::{FieldGradients, GpuField, MeshField, SH_C0, SH_FLOATS, vertex_corners};
 pub use kernels::{MAX_PARTS, TILE};
 pub use rasterizer::{
-    BASE_CHANNELS, ForwardStats, RasterSettings, RasterState, Rasterizer, RenderImages,
-    sort_key_bits,
+    BASE_CHANNELS, ForwardStats, RasterSettings, RasterState, Rasterizer, RenderImages, StageClock,
+    WorkCounts, sort_key_bits,
 };

@@ -86,6 +86,14 @@ pub struct ForwardStats {
     pub key_bits: u32,
 }
 
+/// Work done by one forward + backward pass (see [`RasterState::read_work`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub struct WorkCounts {
+    pub forward_evaluations: u64,
+    pub backward_evaluations: u64,
+    pub hits: u64,
+}
+
 /// Rendered planes read back to the CPU (see [`RasterState::read_render`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct RenderImages {
@@ -110,27 +118,24 @@ impl RenderImages {
     }
 }
 
-/// Optional per-stage wall-clock timing (native only; for benchmarks). When enabled, every
+/// Optional per-stage wall-clock timing (for benchmarks). When enabled, every
 /// stage is submitted and waited for on its own, which serialises the GPU: use it to see where
 /// time goes, not to measure throughput.
 #[derive(Debug, Default)]
 pub struct StageClock {
     enabled: bool,
-    #[cfg(not(target_arch = "wasm32"))]
-    last: Option<std::time::Instant>,
+    last: f64,
     /// (stage, milliseconds) in order, accumulated until [`StageClock::take`].
     times: Vec<(&'static str, f64)>,
 }
 
 impl StageClock {
     fn start(&mut self) {
-        #[cfg(not(target_arch = "wasm32"))]
-        if self.enabled {
-            self.last = Some(std::time::Instant::now());
-        }
+        self.last = crate::gpu::now_seconds();
     }
 
     /// Submits what `encoder` holds, waits, and books the time since the last lap on `stage`.
+    /// In the browser the wait is not possible: there the times only mark submissions.
     fn lap(&mut self, ctx: &GpuContext, encoder: &mut wgpu::CommandEncoder, stage: &'static str) {
         if !self.enabled {
             return;
@@ -141,10 +146,9 @@ impl StageClock {
         );
         ctx.queue.submit([done.finish()]);
         let _ = ctx.poll_wait();
-        #[cfg(not(target_arch = "wasm32"))]
-        if let Some(last) = self.last.replace(std::time::Instant::now()) {
-            self.times.push((stage, last.elapsed().as_secs_f64() * 1e3));
-        }
+        let now = crate::gpu::now_seconds();
+        self.times.push((stage, (now - self.last) * 1e3));
+        self.last = now;
     }
 
     /// The stage times booked so far (and clears them).
@@ -203,7 +207,7 @@ impl RasterState {
     /// capacity grow as needed.
     pub fn new(ctx: &GpuContext, width: u32, height: u32, num_parts: u32) -> GpuResult<Self> {
         if width == 0 || height == 0 {
-            return Err(GpuError::Device(format!(
+            return Err(GpuError::InvalidInput(format!(
                 "cannot render a {width}x{height} image"
             )));
         }
@@ -264,6 +268,21 @@ impl RasterState {
         )
     }
 
+    /// Books the time since the last stage on `stage` when profiling (an empty name starts a new
+    /// interval without booking): lets callers time their own stages between rasterizer calls.
+    pub fn clock_lap(
+        &mut self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        stage: &'static str,
+    ) {
+        if stage.is_empty() {
+            self.clock.start();
+        } else {
+            self.clock.lap(ctx, encoder, stage);
+        }
+    }
+
     /// Times every stage separately from now on (see [`StageClock`]).
     pub fn set_profiling(&mut self, enabled: bool) {
         self.clock.enabled = enabled;
@@ -313,6 +332,48 @@ impl RasterState {
             .chunks_exact(2)
             .map(|s| (f32::from_bits(s[0]), s[1]))
             .collect())
+    }
+
+    /// Counts the work of the last forward pass (for benchmarks): per-pixel face evaluations of
+    /// the forward and backward compositing loops, and the hits (contributions with α ≥ alpha_min)
+    /// as the face statistics recorded them since they were last cleared.
+    pub async fn read_work(&self, ctx: &GpuContext, faces: u32) -> GpuResult<WorkCounts> {
+        let tiles_x = self.width.div_ceil(TILE);
+        let tiles = (tiles_x * self.height.div_ceil(TILE)) as usize;
+        let ranges: Vec<u32> = ctx.read_buffer(&self.tile_ranges, 2 * tiles).await?;
+        let render = self.read_render(ctx).await?;
+        let n = (self.width * self.height) as usize;
+        let planes = BASE_CHANNELS + self.num_parts as usize;
+        let consumed: Vec<u32> =
+            ctx.read_buffer(&self.render, (planes + 1) * n).await?[planes * n..].to_vec();
+        let t_min = self.last_params.transmittance_min;
+        let (mut forward, mut backward) = (0u64, 0u64);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let tile = ((y / TILE) * tiles_x + x / TILE) as usize;
+                let len = u64::from(ranges[2 * tile + 1].saturating_sub(ranges[2 * tile]));
+                let i = (y * self.width + x) as usize;
+                let used = u64::from(consumed[i]);
+                // A saturated pixel stops at its last contributor; the others scan the whole list.
+                forward += if 1.0 - render.plane(4)[i] < t_min {
+                    used
+                } else {
+                    len
+                };
+                backward += used;
+            }
+        }
+        let hits = self
+            .read_face_stats(ctx, faces)
+            .await?
+            .iter()
+            .map(|s| u64::from(s.1))
+            .sum();
+        Ok(WorkCounts {
+            forward_evaluations: forward,
+            backward_evaluations: backward,
+            hits,
+        })
     }
 
     /// Reads the last forward pass's images.
@@ -406,13 +467,13 @@ impl Rasterizer {
         settings: &RasterSettings,
     ) -> GpuResult<ForwardStats> {
         if (camera.intrinsics.width, camera.intrinsics.height) != (state.width, state.height) {
-            return Err(GpuError::Device(format!(
+            return Err(GpuError::InvalidInput(format!(
                 "camera is {}x{} but the raster state was made for {}x{}",
                 camera.intrinsics.width, camera.intrinsics.height, state.width, state.height
             )));
         }
         if field.num_parts != state.num_parts {
-            return Err(GpuError::Device(format!(
+            return Err(GpuError::InvalidInput(format!(
                 "mesh field has {} parts but the raster state was made for {}",
                 field.num_parts, state.num_parts
             )));
