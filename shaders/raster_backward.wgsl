@@ -95,7 +95,7 @@ struct FaceGrad {
 }
 
 fn start_pixel(px: u32, py: u32) -> Pixel {
-    var s: Pixel;
+    var s = Pixel();
     s.p = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
     s.transmittance = 1.0;
     s.done = px >= params.width || py >= params.height;
@@ -232,7 +232,7 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
         for (var b = 0u; b < count; b++) {
             let geom = batch[b];
             let entry = start + b - r.x;
-            var fg: FaceGrad;
+            var fg = FaceGrad();
             backprop(&s0, &fg, geom, b, entry);
             backprop(&s1, &fg, geom, b, entry);
             backprop(&s2, &fg, geom, b, entry);

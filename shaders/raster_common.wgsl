@@ -3,8 +3,12 @@
 //
 // Conventions: pixel coordinates have their origin at the top-left image corner, pixel centres at
 // +0.5; the camera looks down −z (OpenGL); w = −z_camera is the view depth (metres).
+//
+// Every function-scope `var` has an explicit initializer (`T()`): in Chromium 156 (SwiftShader) a
+// `var x: T;` declared inside a loop kept the previous iteration's value instead of being zeroed,
+// which corrupted the backward pass there while lavapipe was right.
 
-const TILE: u32 = 16u;                 // tile side in pixels; one workgroup (256 pixels) per tile
+const TILE: u32 = 16u;                 // tile side in pixels; one workgroup per tile
 const MAX_PARTS: u32 = 16u;            // part logits per vertex (K + 1), at most
 const PAIR_GRADS: u32 = 25u;           // per-(face, tile) gradient floats, without part logits
 const CORNER_GRADS: u32 = 8u;          // per-corner gradient floats before the part logits
@@ -83,7 +87,7 @@ struct Hit {
 // functions and s the incenter, written as (min_i distance to edge i / inradius)^γ
 // = (min_i λ_i · perimeter / l_i)^γ.
 fn evaluate_face(g: FaceGeometry, p: vec2<f32>, params: RasterParams) -> Hit {
-    var hit: Hit;
+    var hit = Hit();
     hit.alpha = 0.0;
     let d = p - vec2<f32>(g.geom_x.w, g.geom_y.w);
     let lambda = vec3<f32>(

@@ -41,7 +41,7 @@ struct Pixel {
 }
 
 fn start_pixel(px: u32, py: u32) -> Pixel {
-    var s: Pixel;
+    var s = Pixel();
     s.p = vec2<f32>(f32(px) + 0.5, f32(py) + 0.5);
     s.transmittance = 1.0;
     s.done = px >= params.width || py >= params.height;

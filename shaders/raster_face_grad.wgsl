@@ -30,7 +30,7 @@ fn face_gradients(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let first = offsets[f];
     let last = offsets[f + 1u];
 
-    var g: array<f32, PAIR_GRADS>;
+    var g = array<f32, PAIR_GRADS>();
     for (var e = first; e < last; e++) {
         let j = pair_slot[e];
         for (var c = 0u; c < PAIR_GRADS; c++) {
@@ -63,9 +63,9 @@ fn face_gradients(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
 
     // Recompute the projection (as in raster_project.wgsl).
     var idx = vec3<u32>(faces[3u * f], faces[3u * f + 1u], faces[3u * f + 2u]);
-    var s: array<vec2<f32>, 3>;
-    var cam: array<vec3<f32>, 3>;
-    var w: vec3<f32>;
+    var s = array<vec2<f32>, 3>();
+    var cam = array<vec3<f32>, 3>();
+    var w = vec3<f32>();
     for (var i = 0u; i < 3u; i++) {
         let c = params.world_to_camera * vec4<f32>(positions[idx[i]].xyz, 1.0);
         cam[i] = c.xyz;
@@ -73,14 +73,14 @@ fn face_gradients(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         s[i] = vec2<f32>(params.focal.z + params.focal.x * c.x / w[i], params.focal.w - params.focal.y * c.y / w[i]);
     }
     let area2 = cross2(s[1] - s[0], s[2] - s[0]);
-    var a: array<vec2<f32>, 3>;
+    var a = array<vec2<f32>, 3>();
     a[0] = vec2<f32>(s[1].y - s[2].y, s[2].x - s[1].x) / area2;
     a[1] = vec2<f32>(s[2].y - s[0].y, s[0].x - s[2].x) / area2;
     a[2] = vec2<f32>(s[0].y - s[1].y, s[1].x - s[0].x) / area2;
     let l = vec3<f32>(length(s[1] - s[2]), length(s[2] - s[0]), length(s[0] - s[1]));
     let perimeter = l.x + l.y + l.z;
 
-    var gs: array<vec2<f32>, 3>;
+    var gs = array<vec2<f32>, 3>();
     // λ_i(p) = a_i · (p − s0) + [i == 0]: the origin s0 gets −Σ_i a_i Σ_p dL/dλ_i.
     var g_area = 0.0;
     for (var i = 0u; i < 3u; i++) {

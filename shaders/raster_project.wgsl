@@ -16,7 +16,7 @@ fn sigmoid(x: f32) -> f32 {
 }
 
 fn culled(f: u32) {
-    var rec: FaceRecord;
+    var rec = FaceRecord();
     rec.tiles = vec4<u32>(1u, 0u, 0u, 0u);
     records[f] = rec;
     tile_counts[f] = 0u;
@@ -29,8 +29,8 @@ fn project_faces(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         return;
     }
     var idx = vec3<u32>(faces[3u * f], faces[3u * f + 1u], faces[3u * f + 2u]);
-    var s: array<vec2<f32>, 3>;
-    var w: vec3<f32>;
+    var s = array<vec2<f32>, 3>();
+    var w = vec3<f32>();
     var o = 0.0;
     for (var i = 0u; i < 3u; i++) {
         let x = positions[idx[i]];
@@ -66,7 +66,7 @@ fn project_faces(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let t0 = vec2<u32>(px0) / TILE;
     let t1 = vec2<u32>(px1) / TILE;
 
-    var rec: FaceRecord;
+    var rec = FaceRecord();
     let inv = 1.0 / area2;
     let a0 = vec2<f32>(s[1].y - s[2].y, s[2].x - s[1].x) * inv;
     let a1 = vec2<f32>(s[2].y - s[0].y, s[0].x - s[2].x) * inv;

@@ -36,7 +36,7 @@ fn coeff_count(degree: u32) -> u32 {
 
 // Y_l(d) for l < 16 (unused entries are zero beyond the active degree).
 fn sh_basis(d: vec3<f32>, degree: u32) -> array<f32, 16> {
-    var y: array<f32, 16>;
+    var y = array<f32, 16>();
     let x = d.x;
     let yy = d.y;
     let z = d.z;
@@ -133,7 +133,7 @@ fn sh_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let c = raw_color(v, basis, n);
     // The clamp at 0 passes no gradient.
     let g = select(vec3<f32>(0.0), grad_colors[v].xyz, c > vec3<f32>(0.0));
-    var w: array<f32, 16>;
+    var w = array<f32, 16>();
     for (var l = 0u; l < SH_COEFFS; l++) {
         let base = (v * SH_COEFFS + l) * 3u;
         let gl = g * basis[l];
