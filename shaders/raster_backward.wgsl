@@ -127,7 +127,7 @@ fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeom
     if ((*s).done) {
         return;
     }
-    let hit = evaluate_face(geom, (*s).p, params);
+    let hit = evaluate_face(geom, (*s).p, params.gamma, params.alpha_min);
     if (hit.alpha <= 0.0) {
         return;
     }

@@ -86,7 +86,7 @@ struct Hit {
 // The triangle window of MeshSplatting: φ = ReLU(L(p) / L(s))^γ with L the max of the edge
 // functions and s the incenter, written as (min_i distance to edge i / inradius)^γ
 // = (min_i λ_i · perimeter / l_i)^γ.
-fn evaluate_face(g: FaceGeometry, p: vec2<f32>, params: RasterParams) -> Hit {
+fn evaluate_face(g: FaceGeometry, p: vec2<f32>, gamma: f32, alpha_min: f32) -> Hit {
     var hit = Hit();
     hit.alpha = 0.0;
     let d = p - vec2<f32>(g.geom_x.w, g.geom_y.w);
@@ -103,10 +103,10 @@ fn evaluate_face(g: FaceGeometry, p: vec2<f32>, params: RasterParams) -> Hit {
     if (u <= 0.0) {
         return hit;
     }
-    let phi = pow(u, params.gamma);
+    let phi = pow(u, gamma);
     let raw = g.window.w * phi;
     let alpha = min(raw, 0.99);
-    if (alpha < params.alpha_min || alpha <= 0.0) {
+    if (alpha < alpha_min || alpha <= 0.0) {
         return hit;
     }
     let rho = lambda * g.inv_w.xyz;

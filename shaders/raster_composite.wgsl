@@ -56,7 +56,7 @@ fn shade(s: ptr<function, Pixel>, g: FaceGeometry, b: u32, entry: u32) {
     if ((*s).done) {
         return;
     }
-    let hit = evaluate_face(g, (*s).p, params);
+    let hit = evaluate_face(g, (*s).p, params.gamma, params.alpha_min);
     if (hit.alpha <= 0.0) {
         return;
     }
