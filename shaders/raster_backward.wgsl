@@ -23,7 +23,8 @@
 @group(0) @binding(7) var<storage, read_write> pair_grads: array<f32>;
 @group(0) @binding(8) var<storage, read_write> pair_logit_grads: array<f32>;
 
-const INVOCATIONS: u32 = 64u;
+const PIXELS: u32 = 4u;                  // pixels per invocation, rows of one column
+const INVOCATIONS: u32 = TILE * TILE / PIXELS;
 const BATCH: u32 = 32u;
 var<workgroup> batch: array<FaceGeometry, BATCH>;
 var<workgroup> batch_face: array<u32, BATCH>;
@@ -209,7 +210,7 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
         return;
     }
     let px = (tile % params.tiles_x) * TILE + lid % TILE;
-    let py = (tile / params.tiles_x) * TILE + (lid / TILE) * 4u;
+    let py = (tile / params.tiles_x) * TILE + (lid / TILE) * PIXELS;
     if (lid == 0u) {
         range = vec2<u32>(tile_ranges[2u * tile], tile_ranges[2u * tile + 1u]);
     }
@@ -220,11 +221,10 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
     let r = workgroupUniformLoad(&range);
     let logit_stride = 3u * params.num_parts;
     for (var start = r.x; start < r.y; start += BATCH) {
-        let j = start + lid;
-        if (lid < BATCH && j < r.y) {
-            let f = sorted_face[j];
-            batch_face[lid] = f;
-            batch[lid] = face_geometry(records[f]);
+        for (var i = lid; i < BATCH && start + i < r.y; i += INVOCATIONS) {
+            let f = sorted_face[start + i];
+            batch_face[i] = f;
+            batch[i] = face_geometry(records[f]);
         }
         workgroupBarrier();
         let count = min(BATCH, r.y - start);

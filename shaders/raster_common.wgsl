@@ -8,7 +8,7 @@
 // `var x: T;` declared inside a loop kept the previous iteration's value instead of being zeroed,
 // which corrupted the backward pass there while lavapipe was right.
 
-const TILE: u32 = 16u;                 // tile side in pixels; one workgroup per tile
+const TILE: u32 = 8u;                  // tile side in pixels; one workgroup per tile
 const MAX_PARTS: u32 = 16u;            // part logits per vertex (K + 1), at most
 const PAIR_GRADS: u32 = 25u;           // per-(face, tile) gradient floats, without part logits
 const CORNER_GRADS: u32 = 8u;          // per-corner gradient floats before the part logits

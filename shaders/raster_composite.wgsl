@@ -1,11 +1,14 @@
-// Forward compositing: one workgroup per 16×16 tile. Faces of the tile arrive depth-sorted
+// Forward compositing: one workgroup per 8×8 tile. Faces of the tile arrive depth-sorted
 // (front to back) and are staged in workgroup memory in batches; each pixel composites
 // α_n = min(0.99, σ_n φ_n(p)) with colour, depth and part logits interpolated by
 // perspective-correct barycentrics, skipping α < alpha_min and stopping once T < transmittance_min.
 //
-// Each invocation shades PIXELS = 4 pixels of one column (rows 4r .. 4r+3): a staged face is read
-// from workgroup memory once for four pixels. CPU drivers (lavapipe, SwiftShader) turn every
-// workgroup-memory read into a per-lane gather, which made that read the dominant cost.
+// Each invocation shades PIXELS = 8 pixels, a whole column of the tile: a staged face is read from
+// workgroup memory once for eight pixels. CPU drivers (lavapipe, SwiftShader) turn every
+// workgroup-memory read into a per-lane gather, which made that read the dominant cost. Tiles are
+// 8×8 rather than 3DGS's 16×16 because our faces are small: with faces of a pixel or two, a
+// 16×16 tile lists ~4× more faces than cover any one of its pixels (measured: 3.7× fewer
+// evaluations and 1.7–2.9× faster iterations on lavapipe at 8×8).
 //
 // Output planes (planar f32, plane c at c · width · height): 0–2 RGB over the background,
 // 3 expected depth Σ w z, 4 accumulated alpha Σ w, 5.. part logits Σ w s, and after the P logit

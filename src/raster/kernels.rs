@@ -8,8 +8,8 @@ use crate::gpu::{Binding, GpuContext, KernelFamily};
 
 const COMMON: &str = include_str!("../../shaders/raster_common.wgsl");
 
-/// Tile side in pixels (one 256-invocation workgroup per tile).
-pub const TILE: u32 = 16;
+/// Tile side in pixels (one workgroup per tile).
+pub const TILE: u32 = 8;
 /// Most part logits per vertex (K + 1 with K = 15 movable parts).
 pub const MAX_PARTS: usize = 16;
 /// Floats per (face, tile) pair gradient, without part logits (`PAIR_GRADS` in WGSL).
