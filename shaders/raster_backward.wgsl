@@ -13,11 +13,6 @@
 // 9–11 dL/dk_i, 12–14 dL/d(1/w_i), 15 dL/dσ, 16–24 dL/dcolour_i (i major); part logits in their
 // own buffer, 3·P floats per pair (vertex major).
 
-@group(0) @binding(0) var<uniform> params: RasterParams;
-@group(0) @binding(1) var<storage, read> tile_ranges: array<u32>;
-@group(0) @binding(2) var<storage, read> sorted_face: array<u32>;
-@group(0) @binding(3) var<storage, read> records: array<FaceRecord>;
-@group(0) @binding(4) var<storage, read> part_logits: array<f32>;
 @group(0) @binding(5) var<storage, read> render: array<f32>;
 @group(0) @binding(6) var<storage, read> grad_render: array<f32>;
 @group(0) @binding(7) var<storage, read_write> pair_grads: array<f32>;
@@ -25,12 +20,8 @@
 
 const PIXELS: u32 = 4u;                  // pixels per invocation, rows of one column
 const INVOCATIONS: u32 = TILE * TILE / PIXELS;
-const BATCH: u32 = 32u;
-var<workgroup> batch: array<FaceGeometry, BATCH>;
-var<workgroup> batch_face: array<u32, BATCH>;
 var<workgroup> acc: array<atomic<u32>, BATCH * PAIR_GRADS>;
 var<workgroup> acc_logits: array<atomic<u32>, BATCH * 3u * MAX_PARTS>;
-var<workgroup> range: vec2<u32>;
 
 fn add_acc(i: u32, v: f32) {
     if (v == 0.0) {
@@ -132,18 +123,13 @@ fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeom
     if (hit.alpha <= 0.0) {
         return;
     }
-    // Only the fields a hit needs: a whole-record load is 36 per-lane gathers on CPU drivers.
-    let f = batch_face[b];
-    let c0 = records[f].color0.xyz;
-    let c1 = records[f].color1.xyz;
-    let c2 = records[f].color2.xyz;
-    let v = records[f].verts;
+    let hv = hit_vertices(batch_face[b]);
     let parts = params.num_parts;
     let mu = hit.mu;
     let t = (*s).transmittance;
     let w = hit.alpha * t;
     let one_minus = 1.0 - hit.alpha;
-    let color = mu.x * c0 + mu.y * c1 + mu.z * c2;
+    let color = mu.x * hv.c0 + mu.y * hv.c1 + mu.z * hv.c2;
     (*s).pre_rgb += w * color;
     (*s).pre_depth += w * hit.z;
     (*s).pre_alpha += w;
@@ -152,10 +138,10 @@ fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeom
         + (*s).g_alpha * (t - ((*s).out_alpha - (*s).pre_alpha) / one_minus);
     // dL/dμ_i from colour and logits (depth goes through 1/Σρ below).
     let gc = (*s).g_rgb * w;
-    var g_mu = vec3<f32>(dot(gc, c0), dot(gc, c1), dot(gc, c2));
+    var g_mu = vec3<f32>(dot(gc, hv.c0), dot(gc, hv.c1), dot(gc, hv.c2));
     let logit_base = b * 3u * parts;
     for (var k = 0u; k < parts; k++) {
-        let sv = vec3<f32>(part_logits[v.x * parts + k], part_logits[v.y * parts + k], part_logits[v.z * parts + k]);
+        let sv = vertex_logits(hv.verts, k);
         let sk = dot(mu, sv);
         (*s).pre_logits[k] += w * sk;
         let gk = (*s).g_logits[k];
@@ -209,23 +195,17 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
     if (tile >= params.tiles_x * params.tiles_y) {
         return;
     }
-    let px = (tile % params.tiles_x) * TILE + lid % TILE;
-    let py = (tile / params.tiles_x) * TILE + (lid / TILE) * PIXELS;
-    if (lid == 0u) {
-        range = vec2<u32>(tile_ranges[2u * tile], tile_ranges[2u * tile + 1u]);
-    }
+    let column = column_pixel(tile, lid, PIXELS);
+    let px = column.x;
+    let py = column.y;
     var s0 = start_pixel(px, py);
     var s1 = start_pixel(px, py + 1u);
     var s2 = start_pixel(px, py + 2u);
     var s3 = start_pixel(px, py + 3u);
-    let r = workgroupUniformLoad(&range);
+    let r = tile_range(tile, lid);
     let logit_stride = 3u * params.num_parts;
     for (var start = r.x; start < r.y; start += BATCH) {
-        for (var i = lid; i < BATCH && start + i < r.y; i += INVOCATIONS) {
-            let f = sorted_face[start + i];
-            batch_face[i] = f;
-            batch[i] = face_geometry(records[f]);
-        }
+        stage_batch(start, r.y, lid, INVOCATIONS);
         workgroupBarrier();
         let count = min(BATCH, r.y - start);
         // Uniform loop (see raster_composite.wgsl).

@@ -16,20 +16,11 @@
 // Per face it records the largest blending weight w = α T (as f32 bits: atomicMax on u32 orders
 // non-negative floats correctly) and how many pixels it reached.
 
-@group(0) @binding(0) var<uniform> params: RasterParams;
-@group(0) @binding(1) var<storage, read> tile_ranges: array<u32>;
-@group(0) @binding(2) var<storage, read> sorted_face: array<u32>;
-@group(0) @binding(3) var<storage, read> records: array<FaceRecord>;
-@group(0) @binding(4) var<storage, read> part_logits: array<f32>;   // [vertex][part]
 @group(0) @binding(5) var<storage, read_write> render: array<f32>;
 @group(0) @binding(6) var<storage, read_write> face_stats: array<atomic<u32>>;  // [face]: max weight bits, pixel count
 
 const PIXELS: u32 = 8u;                  // pixels per invocation, rows of one column
 const INVOCATIONS: u32 = TILE * TILE / PIXELS;
-const BATCH: u32 = 64u;
-var<workgroup> batch: array<FaceGeometry, BATCH>;
-var<workgroup> batch_face: array<u32, BATCH>;
-var<workgroup> range: vec2<u32>;
 var<workgroup> finished: atomic<u32>;
 
 struct Pixel {
@@ -64,20 +55,13 @@ fn shade(s: ptr<function, Pixel>, g: FaceGeometry, b: u32, entry: u32) {
         return;
     }
     let f = batch_face[b];
-    // Only the fields a hit needs: a whole-record load is 36 per-lane gathers on CPU drivers.
-    let c0 = records[f].color0.xyz;
-    let c1 = records[f].color1.xyz;
-    let c2 = records[f].color2.xyz;
-    let v = records[f].verts;
-    let parts = params.num_parts;
+    let hv = hit_vertices(f);
     let w = hit.alpha * (*s).transmittance;
-    (*s).rgb += w * (hit.mu.x * c0 + hit.mu.y * c1 + hit.mu.z * c2);
+    (*s).rgb += w * (hit.mu.x * hv.c0 + hit.mu.y * hv.c1 + hit.mu.z * hv.c2);
     (*s).depth += w * hit.z;
     (*s).alpha += w;
-    for (var k = 0u; k < parts; k++) {
-        (*s).logits[k] += w * (hit.mu.x * part_logits[v.x * parts + k]
-            + hit.mu.y * part_logits[v.y * parts + k]
-            + hit.mu.z * part_logits[v.z * parts + k]);
+    for (var k = 0u; k < params.num_parts; k++) {
+        (*s).logits[k] += w * dot(hit.mu, vertex_logits(hv.verts, k));
     }
     atomicMax(&face_stats[2u * f], bitcast<u32>(w));
     atomicAdd(&face_stats[2u * f + 1u], 1u);
@@ -113,11 +97,9 @@ fn composite_forward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     if (tile >= params.tiles_x * params.tiles_y) {
         return;
     }
-    let px = (tile % params.tiles_x) * TILE + lid % TILE;
-    let py = (tile / params.tiles_x) * TILE + (lid / TILE) * PIXELS;
-    if (lid == 0u) {
-        range = vec2<u32>(tile_ranges[2u * tile], tile_ranges[2u * tile + 1u]);
-    }
+    let column = column_pixel(tile, lid, PIXELS);
+    let px = column.x;
+    let py = column.y;
     var s0 = start_pixel(px, py + 0u);
     var s1 = start_pixel(px, py + 1u);
     var s2 = start_pixel(px, py + 2u);
@@ -126,13 +108,9 @@ fn composite_forward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     var s5 = start_pixel(px, py + 5u);
     var s6 = start_pixel(px, py + 6u);
     var s7 = start_pixel(px, py + 7u);
-    let r = workgroupUniformLoad(&range);
+    let r = tile_range(tile, lid);
     for (var start = r.x; start < r.y; start += BATCH) {
-        for (var i = lid; i < BATCH && start + i < r.y; i += INVOCATIONS) {
-            let f = sorted_face[start + i];
-            batch_face[i] = f;
-            batch[i] = face_geometry(records[f]);
-        }
+        stage_batch(start, r.y, lid, INVOCATIONS);
         workgroupBarrier();
         // A uniform loop (no break on `done`): a divergent counter would make `batch[b]` a gather.
         let count = min(BATCH, r.y - start);

@@ -53,7 +53,7 @@ impl Default for PhotometricConfig {
             opacity_lr: 3e-2,
             part_lr: 5e-3,
             gamma: (1.0, 0.02),
-            opacity_ramp: (0.5, 0.9),
+            opacity_ramp: (0.4, 0.7),
             sh_degree_every: 100,
             max_sh_degree: 3,
             weights: LossWeights::default(),

@@ -7,6 +7,8 @@ use bytemuck::{Pod, Zeroable};
 use crate::gpu::{Binding, GpuContext, KernelFamily};
 
 const COMMON: &str = include_str!("../../shaders/raster_common.wgsl");
+/// Bindings and helpers shared by the two per-tile compositing kernels.
+const TILE_COMMON: &str = include_str!("../../shaders/raster_tile.wgsl");
 
 /// Tile side in pixels (one workgroup per tile).
 pub const TILE: u32 = 8;
@@ -102,11 +104,28 @@ impl ShKernels {
 
 /// A family with a single entry point.
 pub struct Kernel {
-    pub family: KernelFamily,
-    pub pipeline: wgpu::ComputePipeline,
+    family: KernelFamily,
+    pipeline: wgpu::ComputePipeline,
+    label: &'static str,
 }
 
 impl Kernel {
+    /// Binds `buffers` (in binding order) and records `workgroups` linear workgroups.
+    pub fn run(
+        &self,
+        ctx: &GpuContext,
+        encoder: &mut wgpu::CommandEncoder,
+        buffers: &[&wgpu::Buffer],
+        workgroups: u32,
+    ) {
+        let bind = self.family.bind(ctx, buffers);
+        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
+            label: Some(self.label),
+            timestamp_writes: None,
+        });
+        ctx.dispatch(&mut pass, &self.pipeline, &bind, workgroups);
+    }
+
     fn new(
         ctx: &GpuContext,
         label: &'static str,
@@ -115,7 +134,11 @@ impl Kernel {
         entry: &str,
     ) -> Self {
         let (family, [pipeline]) = family(ctx, label, source, bindings, [entry]);
-        Self { family, pipeline }
+        Self {
+            family,
+            pipeline,
+            label,
+        }
     }
 
     /// `shaders/raster_project.wgsl`: projection, culling, face records, tile counts.
@@ -134,7 +157,10 @@ impl Kernel {
         Self::new(
             ctx,
             "raster_composite",
-            include_str!("../../shaders/raster_composite.wgsl"),
+            &format!(
+                "{TILE_COMMON}\n{}",
+                include_str!("../../shaders/raster_composite.wgsl")
+            ),
             &[U, R, R, R, R, RW, RW],
             "composite_forward",
         )
@@ -145,7 +171,10 @@ impl Kernel {
         Self::new(
             ctx,
             "raster_backward",
-            include_str!("../../shaders/raster_backward.wgsl"),
+            &format!(
+                "{TILE_COMMON}\n{}",
+                include_str!("../../shaders/raster_backward.wgsl")
+            ),
             &[U, R, R, R, R, R, R, RW, RW],
             "composite_backward",
         )

@@ -497,8 +497,11 @@ impl Rasterizer {
             vertex_groups,
         );
         state.clock.lap(ctx, &mut encoder, "sh colours");
-        let project_bind = self.project.family.bind(
+        // The scan covers one extra (zero) element so offsets[F] is the total.
+        encoder.clear_buffer(&state.offsets, 0, None);
+        self.project.run(
             ctx,
+            &mut encoder,
             &[
                 &state.params,
                 &field.positions,
@@ -508,13 +511,6 @@ impl Rasterizer {
                 &state.records,
                 &state.offsets,
             ],
-        );
-        // The scan covers one extra (zero) element so offsets[F] is the total.
-        encoder.clear_buffer(&state.offsets, 0, None);
-        ctx.dispatch(
-            &mut pass(&mut encoder, "raster.project"),
-            &self.project.pipeline,
-            &project_bind,
             face_groups,
         );
         state.clock.lap(ctx, &mut encoder, "project");
@@ -533,7 +529,20 @@ impl Rasterizer {
         state.last_params = params;
 
         // 2. Binning, sort, tile ranges, compositing.
-        let bin_bind = self.bin_bind_group(ctx, state);
+        let bin_bind = self.bin.family.bind(
+            ctx,
+            &[
+                &state.params,
+                &state.records,
+                &state.offsets,
+                state.sorter.keys(),
+                state.sorter.values(),
+                &state.pair_face,
+                &state.sorted_face,
+                &state.pair_slot,
+                &state.tile_ranges,
+            ],
+        );
         ctx.dispatch(
             &mut pass(&mut encoder, "raster.emit"),
             &self.bin.emit_pairs,
@@ -553,8 +562,9 @@ impl Rasterizer {
             pairs.div_ceil(256),
         );
         state.clock.lap(ctx, &mut encoder, "tile ranges");
-        let composite_bind = self.composite.family.bind(
+        self.composite.run(
             ctx,
+            &mut encoder,
             &[
                 &state.params,
                 &state.tile_ranges,
@@ -564,13 +574,7 @@ impl Rasterizer {
                 &state.render,
                 &state.face_stats,
             ],
-        );
-        let tiles = params.tiles_x * params.tiles_y;
-        ctx.dispatch(
-            &mut pass(&mut encoder, "raster.composite"),
-            &self.composite.pipeline,
-            &composite_bind,
-            tiles,
+            params.tiles_x * params.tiles_y,
         );
         state.clock.lap(ctx, &mut encoder, "composite forward");
         ctx.queue.submit([encoder.finish()]);
@@ -592,8 +596,9 @@ impl Rasterizer {
     ) {
         let params = state.last_params;
         state.clock.start();
-        let backward_bind = self.backward.family.bind(
+        self.backward.run(
             ctx,
+            encoder,
             &[
                 &state.params,
                 &state.tile_ranges,
@@ -605,17 +610,12 @@ impl Rasterizer {
                 &state.pair_grads,
                 &state.pair_logit_grads,
             ],
-        );
-        let tiles = params.tiles_x * params.tiles_y;
-        ctx.dispatch(
-            &mut pass(encoder, "raster.backward"),
-            &self.backward.pipeline,
-            &backward_bind,
-            tiles,
+            params.tiles_x * params.tiles_y,
         );
         state.clock.lap(ctx, encoder, "composite backward");
-        let face_bind = self.face_gradients.family.bind(
+        self.face_gradients.run(
             ctx,
+            encoder,
             &[
                 &state.params,
                 &field.positions,
@@ -627,16 +627,13 @@ impl Rasterizer {
                 &state.pair_logit_grads,
                 &state.corner_grads,
             ],
-        );
-        ctx.dispatch(
-            &mut pass(encoder, "raster.face_grad"),
-            &self.face_gradients.pipeline,
-            &face_bind,
             field.num_faces.div_ceil(256),
         );
         state.clock.lap(ctx, encoder, "face gradients");
-        let vertex_bind = self.vertex_gradients.family.bind(
+        let vertex_groups = field.num_vertices.div_ceil(256);
+        self.vertex_gradients.run(
             ctx,
+            encoder,
             &[
                 &state.params,
                 &field.csr_offsets,
@@ -647,12 +644,6 @@ impl Rasterizer {
                 &field.grad_opacity,
                 &field.grad_part_logits,
             ],
-        );
-        let vertex_groups = field.num_vertices.div_ceil(256);
-        ctx.dispatch(
-            &mut pass(encoder, "raster.vertex_grad"),
-            &self.vertex_gradients.pipeline,
-            &vertex_bind,
             vertex_groups,
         );
         state.clock.lap(ctx, encoder, "vertex gather");
@@ -682,23 +673,6 @@ impl Rasterizer {
                 &field.grad_colors,
                 &field.grad_sh,
                 &field.grad_positions,
-            ],
-        )
-    }
-
-    fn bin_bind_group(&self, ctx: &GpuContext, state: &RasterState) -> wgpu::BindGroup {
-        self.bin.family.bind(
-            ctx,
-            &[
-                &state.params,
-                &state.records,
-                &state.offsets,
-                state.sorter.keys(),
-                state.sorter.values(),
-                &state.pair_face,
-                &state.sorted_face,
-                &state.pair_slot,
-                &state.tile_ranges,
             ],
         )
     }
