@@ -2,8 +2,10 @@
 # The README's main-job command. Today: generates the built-in default object (a procedural
 # StorageFurniture cabinet with three drawers and two doors, seed 4), captures it as a two-state RGB-D dataset
 # with part maps and ground truth, checks the dataset with `artmesh info`, scores the ground truth
-# against itself with `artmesh eval` (all zeros), and runs the GPU self-test. The fit itself joins
-# once the reconstruction and articulation phases land. Usage: scripts/demo.sh [OUTPUT_DIR]
+# against itself with `artmesh eval` (all zeros), runs the GPU self-test, and runs the differentiable
+# rasterizer's learning driver (`artmesh learn`: a jittered grey copy of a procedural box fitted to 8 views
+# at 64x64, printing the loss and PSNR as it goes). The full fit joins once the reconstruction and
+# articulation phases land. Usage: scripts/demo.sh [OUTPUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh --native
@@ -17,4 +19,6 @@ target/release/artmesh synth --category storage --parts 5 --seed 4 --out "$out" 
 target/release/artmesh info "$out"
 target/release/artmesh eval "$out" "$out" --samples 2000 | grep -E '"(axis_ang|axis_pos|part_motion)"' | sort | uniq -c
 target/release/artmesh gpu
-echo "dataset in $out (object as URDF in $out/object)"
+target/release/artmesh learn --size 64 --views 8 --iterations 150 > "$out.learn.json"
+grep -E '"psnr_(start|end)"' "$out.learn.json"
+echo "dataset in $out (object as URDF in $out/object); learning curve in $out.learn.json"

@@ -1,18 +1,18 @@
-// Backward compositing: one workgroup per tile, one invocation per pixel, replaying the forward
-// front-to-back order up to the entries the pixel consumed. With O the pixel's final output and
-// P_n the accumulation up to and including face n,
+// Backward compositing: one workgroup per 8×8 tile, each invocation replaying 4 pixels of one
+// column in the forward front-to-back order, up to the entries each pixel consumed. With O the
+// pixel's final output and P_n the accumulation up to and including face n,
 //   dO/dα_n = q_n T_n − (O − P_n) / (1 − α_n),   dO/dq_n = α_n T_n,
-// so no reverse traversal or division by T is needed. As in the forward pass, each invocation
-// handles 4 pixels of one column; their gradients for a face are summed in registers first. Each
-// pixel's per-face gradient (w.r.t. the
-// face record's barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part
-// logits) is summed over the tile's pixels in workgroup memory (compare-exchange on f32 bits:
-// the browser has no float atomics) and written once per (face, tile) pair, at its sorted slot.
+// so no reverse traversal or division by T is needed. A face's gradient (w.r.t. its record's
+// barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part logits) is summed
+// over the invocation's pixels in registers, then over the tile in workgroup memory
+// (compare-exchange on f32 bits: the browser has no float atomics), and written once per
+// (face, tile) pair, at its sorted slot.
 //
 // Pair gradient layout (PAIR_GRADS floats): 0–2 dL/da_i.x, 3–5 dL/da_i.y, 6–8 Σ dL/dλ_i,
 // 9–11 dL/dk_i, 12–14 dL/d(1/w_i), 15 dL/dσ, 16–24 dL/dcolour_i (i major); part logits in their
 // own buffer, 3·P floats per pair (vertex major).
 
+// Bindings 0–4 (params, tile ranges, sorted faces, records, part logits) are in raster_tile.wgsl.
 @group(0) @binding(5) var<storage, read> render: array<f32>;
 @group(0) @binding(6) var<storage, read> grad_render: array<f32>;
 @group(0) @binding(7) var<storage, read_write> pair_grads: array<f32>;

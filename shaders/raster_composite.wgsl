@@ -16,6 +16,7 @@
 // Per face it records the largest blending weight w = α T (as f32 bits: atomicMax on u32 orders
 // non-negative floats correctly) and how many pixels it reached.
 
+// Bindings 0–4 (params, tile ranges, sorted faces, records, part logits) are in raster_tile.wgsl.
 @group(0) @binding(5) var<storage, read_write> render: array<f32>;
 @group(0) @binding(6) var<storage, read_write> face_stats: array<atomic<u32>>;  // [face]: max weight bits, pixel count
 

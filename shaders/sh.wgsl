@@ -97,6 +97,13 @@ fn vertex_index(wg: Workgroup, lid: u32) -> u32 {
     return workgroup_index(wg) * WG_SIZE + lid;
 }
 
+// Unit direction from the camera centre to vertex v (xyz) and the distance (w).
+fn view_ray(v: u32) -> vec4<f32> {
+    let offset = positions[v].xyz - params.camera_position.xyz;
+    let dist = max(length(offset), 1e-12);
+    return vec4<f32>(offset / dist, dist);
+}
+
 fn raw_color(v: u32, basis: array<f32, 16>, n: u32) -> vec3<f32> {
     var c = vec3<f32>(0.5);
     for (var l = 0u; l < n; l++) {
@@ -112,9 +119,7 @@ fn vertex_colors(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     if (v >= params.num_vertices) {
         return;
     }
-    let offset = positions[v].xyz - params.camera_position.xyz;
-    let d = offset / max(length(offset), 1e-12);
-    let basis = sh_basis(d, params.sh_degree);
+    let basis = sh_basis(view_ray(v).xyz, params.sh_degree);
     let c = raw_color(v, basis, coeff_count(params.sh_degree));
     colors[v] = vec4<f32>(max(c, vec3<f32>(0.0)), 0.0);
 }
@@ -125,9 +130,9 @@ fn sh_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     if (v >= params.num_vertices) {
         return;
     }
-    let offset = positions[v].xyz - params.camera_position.xyz;
-    let dist = max(length(offset), 1e-12);
-    let d = offset / dist;
+    let ray = view_ray(v);
+    let d = ray.xyz;
+    let dist = ray.w;
     let basis = sh_basis(d, params.sh_degree);
     let n = coeff_count(params.sh_degree);
     let c = raw_color(v, basis, n);

@@ -155,10 +155,14 @@ async fn rasterizer_matches_reference_and_finite_differences_in_the_browser() {
         let mut scene = check::scene(seed, 40, 28);
         scene.settings.gamma = gamma;
         let report = check::check_reference(&ctx, &scene, 2e-4).await.unwrap();
+        console_log!("{report:?}");
         assert!(report.passed(), "{report:#?}");
     }
     let scene = check::scene(1, 40, 28);
     let groups = check::check_gradients(&ctx, &scene, 1, 6).await.unwrap();
+    for g in &groups {
+        console_log!("{g:?}");
+    }
     let failed: Vec<_> = groups.iter().filter(|g| !g.passed()).collect();
     assert!(failed.is_empty(), "{failed:#?}");
 }
@@ -197,6 +201,11 @@ async fn a_short_photometric_fit_learns_in_the_browser() {
         .unwrap();
     let first = result.curve.first().unwrap().loss.total;
     let last = result.curve.last().unwrap().loss.total;
+    console_log!(
+        "short fit in the browser: PSNR {:.2} -> {:.2} dB, loss {first:.4} -> {last:.4}",
+        result.psnr_start,
+        result.psnr_end
+    );
     assert!(
         result.psnr_end > result.psnr_start + 3.0 && last < 0.7 * first,
         "PSNR {} -> {}, loss {first} -> {last}",

@@ -145,6 +145,9 @@ mod cli {
             /// Longest edge of the starting mesh, in pixels.
             #[arg(long, default_value_t = 1.5)]
             edge_pixels: f32,
+            /// Also write a PNG (a new file): for three views, target | starting mesh | fitted mesh.
+            #[arg(long)]
+            preview: Option<PathBuf>,
         },
         /// Capture a URDF object (with its meshes) as a two-state dataset with ground truth.
         Render {
@@ -344,8 +347,17 @@ mod cli {
                 views,
                 iterations,
                 edge_pixels,
+                preview,
             } => {
                 use artmesh::fit::photometric::{self, PhotometricConfig, SceneSpec};
+                if let Some(path) = &preview
+                    && path.exists()
+                {
+                    return Err(format!(
+                        "{}: already exists; nothing is overwritten",
+                        path.display()
+                    ));
+                }
                 let spec = SceneSpec {
                     category: artmesh::synth::Category::parse(&category)?,
                     movable_parts: Some(parts),
@@ -380,6 +392,27 @@ mod cli {
                     );
                 }))
                 .map_err(|e| e.to_string())?;
+                if let Some(path) = &preview {
+                    let views = [0, views / 3, 2 * views / 3];
+                    let (w, h, rgb) = pollster::block_on(photometric::preview(
+                        &ctx,
+                        &problem,
+                        &result.field,
+                        &config,
+                        &views,
+                    ))
+                    .map_err(|e| e.to_string())?;
+                    let name = path.display().to_string();
+                    let png = artmesh::data::encode_png(
+                        &name,
+                        w,
+                        h,
+                        artmesh::data::PngPixels::Rgb8(&rgb),
+                    )
+                    .map_err(|e| e.to_string())?;
+                    std::fs::write(path, png).map_err(|e| format!("{name}: {e}"))?;
+                    eprintln!("learn: preview (target | start | fitted) in {name}");
+                }
                 let report = serde_json::json!({
                     "category": spec.category.name(),
                     "size": size,

@@ -477,3 +477,52 @@ pub fn short_fit() -> (SceneSpec, PhotometricConfig) {
         },
     )
 }
+
+/// A preview strip, RGB8: one row per view in `views`, each [target | starting mesh | fitted mesh],
+/// rendered with the run's final settings.
+pub async fn preview(
+    ctx: &GpuContext,
+    problem: &Problem,
+    fitted: &MeshField,
+    config: &PhotometricConfig,
+    views: &[usize],
+) -> GpuResult<(u32, u32, Vec<u8>)> {
+    let Some(first) = problem.frames.first() else {
+        return Err(GpuError::InvalidInput("no views to preview".into()));
+    };
+    let (w, h) = (first.rgba.width, first.rgba.height);
+    let settings = config.settings_at(config.iterations);
+    let raster = Rasterizer::new(ctx);
+    let mut state = RasterState::new(ctx, w, h, problem.field.num_parts as u32)?;
+    let fields = [
+        GpuField::upload(ctx, &problem.field)?,
+        GpuField::upload(ctx, fitted)?,
+    ];
+    let views: Vec<usize> = views
+        .iter()
+        .copied()
+        .filter(|&v| v < problem.frames.len())
+        .collect();
+    let (sheet_w, sheet_h) = (3 * w, h * views.len().max(1) as u32);
+    let mut pixels = vec![0u8; (sheet_w * sheet_h * 3) as usize];
+    let n = (w * h) as usize;
+    for (row, &view) in views.iter().enumerate() {
+        let mut columns = vec![target_rgb(&problem.frames[view], settings.background)];
+        for field in &fields {
+            raster
+                .forward(ctx, field, &mut state, &problem.cameras[view], &settings)
+                .await?;
+            columns.push(state.read_render(ctx).await?.planes[..3 * n].to_vec());
+        }
+        for (col, planes) in columns.iter().enumerate() {
+            for i in 0..n {
+                let (x, y) = (col as u32 * w + i as u32 % w, row as u32 * h + i as u32 / w);
+                let out = ((y * sheet_w + x) * 3) as usize;
+                for c in 0..3 {
+                    pixels[out + c] = (planes[c * n + i].clamp(0.0, 1.0) * 255.0).round() as u8;
+                }
+            }
+        }
+    }
+    Ok((sheet_w, sheet_h, pixels))
+}

@@ -5,7 +5,7 @@
 use glam::{DVec2, DVec3};
 
 use super::field::{MeshField, SH_FLOATS};
-use super::kernels::{LOG_DEPTH_RANGE, TILE};
+use super::kernels::LOG_DEPTH_RANGE;
 use super::rasterizer::{BASE_CHANNELS, RasterSettings, RenderImages, sort_key_bits};
 use crate::data::Camera;
 
@@ -224,11 +224,6 @@ pub fn psnr(a: &[f32], b: &[f32]) -> f64 {
     } else {
         -10.0 * mse.log10()
     }
-}
-
-/// The tile a pixel belongs to (for diagnostics).
-pub fn tile_of(x: u32, y: u32, width: u32) -> u32 {
-    (y / TILE) * width.div_ceil(TILE) + x / TILE
 }
 
 #[cfg(test)]
