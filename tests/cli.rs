@@ -294,3 +294,52 @@ fn synth_and_render_write_datasets_and_refuse_bad_input() {
         );
     }
 }
+
+#[test]
+fn learn_and_bench_raster_print_json() {
+    let tmp = TempDir::new("learn");
+    std::fs::create_dir_all(&tmp.0).unwrap();
+    let preview = tmp.join("preview.png");
+    let args = [
+        "learn",
+        "--size",
+        "32",
+        "--views",
+        "3",
+        "--iterations",
+        "8",
+        "--edge-pixels",
+        "4",
+        "--preview",
+        &preview,
+    ];
+    let report = json(&artmesh(&args));
+    assert_eq!(report["size"], 32);
+    assert!(report["psnr_start"].as_f64().unwrap() > 5.0);
+    assert!(report["curve"].as_array().unwrap().len() >= 2);
+    let png = image::load_from_memory(&std::fs::read(&preview).unwrap()).unwrap();
+    assert_eq!((png.width(), png.height()), (96, 96));
+    // The preview is never overwritten.
+    let again = artmesh(&args);
+    assert!(!again.status.success() && text(&again.stderr).contains("already exists"));
+
+    let bench = json(&artmesh(&[
+        "bench",
+        "raster",
+        "--cases",
+        "32x300",
+        "--repeats",
+        "1",
+    ]));
+    let case = &bench["results"][0];
+    assert_eq!(case["width"], 32);
+    assert!(case["median_ms"].as_f64().unwrap() > 0.0);
+    assert!(case["work"]["forward_evaluations"].as_u64().unwrap() > 0);
+    assert!(bench["fma_peak"]["gflops"].as_f64().unwrap() > 0.0);
+    let bad = artmesh(&["bench", "raster", "--cases", "32by300"]);
+    assert!(
+        !bad.status.success() && text(&bad.stderr).contains("SIZExFACES"),
+        "{}",
+        text(&bad.stderr)
+    );
+}
