@@ -77,6 +77,28 @@ fn buffer_limits_give_clear_errors() {
         );
         ctx.check().expect("no device error after a refused render");
     }
+    // A field without faces renders the background.
+    let mut empty = check::scene(2, 24, 16);
+    empty.field.faces.clear();
+    let field = GpuField::upload(&ctx, &empty.field).unwrap();
+    let mut state = RasterState::new(&ctx, 24, 16, empty.field.num_parts as u32).unwrap();
+    let stats = pollster::block_on(Rasterizer::new(&ctx).forward(
+        &ctx,
+        &field,
+        &mut state,
+        &empty.camera,
+        &empty.settings,
+    ))
+    .unwrap();
+    let img = pollster::block_on(state.read_render(&ctx)).unwrap();
+    assert_eq!(stats.pairs, 0);
+    assert!(img.plane(4).iter().all(|&a| a == 0.0));
+    assert!(
+        (img.rgb(5, 5) - empty.settings.background)
+            .abs()
+            .max_element()
+            < 1e-6
+    );
     // Inconsistent inputs name the problem.
     let mut bad = MeshField::new(vec![glam::Vec3::ZERO; 3], vec![[0, 1, 5]], 2, 0.0);
     let err = GpuField::upload(&ctx, &bad).err().unwrap();

@@ -521,7 +521,7 @@ impl Rasterizer {
         state
             .clock
             .lap(ctx, &mut encoder, "scan + pair count read-back");
-        let pairs = total[0];
+        let pairs = total.first().copied().unwrap_or(0);
         state.ensure_pairs(ctx, pairs)?;
         params.num_pairs = pairs;
         ctx.queue
