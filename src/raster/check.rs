@@ -99,6 +99,11 @@ pub struct ReferenceCheck {
     pub max_abs_logits: f32,
     /// Fraction of pixels with alpha > 0.01 (the scene is not empty).
     pub coverage: f32,
+    /// Largest |GPU − CPU| of the per-face maximum blending weight.
+    pub max_abs_face_weight: f32,
+    /// Faces whose pixel count differs between GPU and CPU (of `faces`).
+    pub face_count_mismatches: usize,
+    pub faces: usize,
     pub tolerance: f32,
 }
 
@@ -108,6 +113,8 @@ impl ReferenceCheck {
             && self.max_abs_color <= self.tolerance
             && self.max_abs_depth <= self.tolerance
             && self.max_abs_logits <= self.tolerance
+            && self.max_abs_face_weight <= self.tolerance
+            && self.face_count_mismatches == 0
     }
 }
 
@@ -125,7 +132,9 @@ pub async fn check_reference(
         .forward(ctx, &field, &mut state, &scene.camera, &scene.settings)
         .await?;
     let gpu = state.read_render(ctx).await?;
-    let cpu = reference::render(&scene.field, &scene.camera, &scene.settings);
+    let gpu_stats = state.read_face_stats(ctx, field.num_faces).await?;
+    let (cpu, cpu_stats) =
+        reference::render_with_stats(&scene.field, &scene.camera, &scene.settings);
     let max_diff = |planes: std::ops::Range<usize>| {
         planes
             .flat_map(|c| {
@@ -143,6 +152,17 @@ pub async fn check_reference(
         max_abs_depth: max_diff(3..4),
         max_abs_logits: max_diff(BASE_CHANNELS..BASE_CHANNELS + gpu.num_parts),
         coverage: alpha.iter().filter(|&&a| a > 0.01).count() as f32 / alpha.len() as f32,
+        max_abs_face_weight: gpu_stats
+            .iter()
+            .zip(&cpu_stats)
+            .map(|(g, c)| (g.0 - c.0).abs())
+            .fold(0.0, f32::max),
+        face_count_mismatches: gpu_stats
+            .iter()
+            .zip(&cpu_stats)
+            .filter(|(g, c)| g.1 != c.1)
+            .count(),
+        faces: cpu_stats.len(),
         tolerance,
     })
 }

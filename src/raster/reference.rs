@@ -92,6 +92,16 @@ fn depth_key(depth: f32, depth_bits: u32) -> u32 {
 
 /// Renders `field` from `camera`: the same planes as [`super::RasterState::read_render`].
 pub fn render(field: &MeshField, camera: &Camera, settings: &RasterSettings) -> RenderImages {
+    render_with_stats(field, camera, settings).0
+}
+
+/// [`render`], plus per face its largest blending weight α·T and the number of pixels it
+/// contributed to (what [`super::RasterState::read_face_stats`] returns for one render).
+pub fn render_with_stats(
+    field: &MeshField,
+    camera: &Camera,
+    settings: &RasterSettings,
+) -> (RenderImages, Vec<(f32, u32)>) {
     let k = camera.intrinsics;
     let (w, h) = (k.width, k.height);
     let parts = field.num_parts;
@@ -141,6 +151,7 @@ pub fn render(field: &MeshField, camera: &Camera, settings: &RasterSettings) -> 
     faces.sort_by_key(|p| (p.key, p.face));
 
     let npix = (w * h) as usize;
+    let mut stats = vec![(0.0f32, 0u32); field.faces.len()];
     let mut planes = vec![0.0f32; (BASE_CHANNELS + parts) * npix];
     let gamma = f64::from(settings.gamma);
     for py in 0..h {
@@ -172,6 +183,8 @@ pub fn render(field: &MeshField, camera: &Camera, settings: &RasterSettings) -> 
                 let zsum: f64 = rho.iter().sum();
                 let mu: Vec<f64> = rho.iter().map(|r| r / zsum).collect();
                 let weight = alpha * t;
+                let stat = &mut stats[face.face];
+                *stat = (stat.0.max(weight as f32), stat.1 + 1);
                 let color =
                     face.colors[0] * mu[0] + face.colors[1] * mu[1] + face.colors[2] * mu[2];
                 acc[0] += weight * color.x;
@@ -203,12 +216,13 @@ pub fn render(field: &MeshField, camera: &Camera, settings: &RasterSettings) -> 
             }
         }
     }
-    RenderImages {
+    let images = RenderImages {
         width: w,
         height: h,
         num_parts: parts,
         planes,
-    }
+    };
+    (images, stats)
 }
 
 /// Peak signal-to-noise ratio (dB) between two RGB images in [0, 1], planar as rendered.
