@@ -10,6 +10,7 @@ pub mod eval;
 pub mod fit;
 pub mod gpu;
 pub mod loss;
+pub mod mesh;
 pub mod object;
 pub mod optim;
 pub mod raster;
