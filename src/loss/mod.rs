@@ -24,10 +24,10 @@ pub use targets::{TARGET_PIXEL_BYTES, TargetImages, TargetView};
 
 use crate::gpu::{Binding, GpuContext, GpuError, GpuResult, KernelFamily};
 
-/// Most part channels the loss accepts (K + 1 parts).
-pub const MAX_PARTS: u32 = 16;
-/// Render channels besides the part logits: RGB, depth, alpha.
-pub const BASE_CHANNELS: u32 = 5;
+/// Most part channels the loss accepts (K + 1 parts): the rasterizer's limit.
+pub const MAX_PARTS: u32 = crate::raster::MAX_PARTS as u32;
+/// Render channels besides the part logits (RGB, depth, alpha), as the rasterizer writes them.
+pub const BASE_CHANNELS: u32 = crate::raster::BASE_CHANNELS as u32;
 /// Pixels per workgroup in `loss.wgsl`.
 const WG_SIZE: u32 = 256;
 /// Floats per workgroup in the partial-sums buffer.

@@ -4,7 +4,7 @@
 
 use bytemuck::{Pod, Zeroable};
 
-use crate::gpu::{Binding, GpuContext, KernelFamily};
+use crate::gpu::{Binding, GpuContext, KernelFamily, compute_pass};
 
 const COMMON: &str = include_str!("../../shaders/raster_common.wgsl");
 /// Bindings and helpers shared by the two per-tile compositing kernels.
@@ -119,11 +119,12 @@ impl Kernel {
         workgroups: u32,
     ) {
         let bind = self.family.bind(ctx, buffers);
-        let mut pass = encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-            label: Some(self.label),
-            timestamp_writes: None,
-        });
-        ctx.dispatch(&mut pass, &self.pipeline, &bind, workgroups);
+        ctx.dispatch(
+            &mut compute_pass(encoder, self.label),
+            &self.pipeline,
+            &bind,
+            workgroups,
+        );
     }
 
     fn new(

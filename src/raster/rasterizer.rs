@@ -11,7 +11,7 @@ use super::kernels::{
     BinKernels, CORNER_GRADS, FACE_RECORD_BYTES, Kernel, PAIR_GRADS, RasterParams, ShKernels, TILE,
 };
 use crate::data::Camera;
-use crate::gpu::{GpuContext, GpuError, GpuResult, PrefixSum, RadixSort};
+use crate::gpu::{GpuContext, GpuError, GpuResult, PrefixSum, RadixSort, compute_pass};
 
 /// Output planes before the part logits: RGB, depth, alpha.
 pub const BASE_CHANNELS: usize = 5;
@@ -435,13 +435,6 @@ impl RasterState {
     }
 }
 
-fn pass<'e>(encoder: &'e mut wgpu::CommandEncoder, label: &'static str) -> wgpu::ComputePass<'e> {
-    encoder.begin_compute_pass(&wgpu::ComputePassDescriptor {
-        label: Some(label),
-        timestamp_writes: None,
-    })
-}
-
 impl Rasterizer {
     /// Compiles every rasterizer kernel.
     pub fn new(ctx: &GpuContext) -> Self {
@@ -491,7 +484,7 @@ impl Rasterizer {
         let vertex_groups = field.num_vertices.div_ceil(256);
         let face_groups = field.num_faces.div_ceil(256);
         ctx.dispatch(
-            &mut pass(&mut encoder, "sh.colors"),
+            &mut compute_pass(&mut encoder, "sh.colors"),
             &self.sh.vertex_colors,
             &sh_bind,
             vertex_groups,
@@ -544,7 +537,7 @@ impl Rasterizer {
             ],
         );
         ctx.dispatch(
-            &mut pass(&mut encoder, "raster.emit"),
+            &mut compute_pass(&mut encoder, "raster.emit"),
             &self.bin.emit_pairs,
             &bin_bind,
             face_groups,
@@ -556,7 +549,7 @@ impl Rasterizer {
         state.clock.lap(ctx, &mut encoder, "radix sort");
         encoder.clear_buffer(&state.tile_ranges, 0, None);
         ctx.dispatch(
-            &mut pass(&mut encoder, "raster.ranges"),
+            &mut compute_pass(&mut encoder, "raster.ranges"),
             &self.bin.tile_ranges,
             &bin_bind,
             pairs.div_ceil(256),
@@ -649,7 +642,7 @@ impl Rasterizer {
         state.clock.lap(ctx, encoder, "vertex gather");
         let sh_bind = self.sh_bind_group(ctx, field, state);
         ctx.dispatch(
-            &mut pass(encoder, "sh.backward"),
+            &mut compute_pass(encoder, "sh.backward"),
             &self.sh.backward,
             &sh_bind,
             vertex_groups,
