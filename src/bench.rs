@@ -386,3 +386,139 @@ pub fn raster(ctx: &GpuContext, cases: &[(u32, usize)], repeats: usize) -> GpuRe
         results,
     })
 }
+
+/// One object of `artmesh bench reconstruct`.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReconstructObject {
+    pub id: String,
+    pub category: &'static str,
+    pub parts: usize,
+    pub seconds: f64,
+    pub report: crate::eval::ReconstructionReport,
+}
+
+/// Time per phase summed over all objects and both states.
+#[derive(Debug, Clone, Copy, Default, Serialize)]
+pub struct PhaseTotals {
+    pub initialise_s: f64,
+    pub optimise_s: f64,
+    pub densify_s: f64,
+    pub remesh_s: f64,
+    pub recover_s: f64,
+    pub measure_s: f64,
+    pub total_s: f64,
+    /// The phase with the largest share, and that share.
+    pub dominant: &'static str,
+    pub dominant_share: f64,
+}
+
+/// `artmesh bench reconstruct` output.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReconstructBench {
+    pub bench: &'static str,
+    pub adapter: AdapterReport,
+    pub preset: crate::fit::reconstruct::ReconstructionConfig,
+    pub capture: CaptureSettings,
+    pub phases: PhaseTotals,
+    pub objects: Vec<ReconstructObject>,
+}
+
+/// How the quick-suite objects were captured for the benchmark.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct CaptureSettings {
+    pub size: u32,
+    pub train_views: usize,
+}
+
+/// Reconstructs the quick-suite objects (all, or those whose id contains one of `only`), each
+/// captured in memory at `size`² with `views` training views per state, and times every phase.
+pub fn reconstruct(
+    ctx: &GpuContext,
+    config: &crate::fit::reconstruct::ReconstructionConfig,
+    only: &[String],
+    size: u32,
+    views: usize,
+    log: &mut dyn FnMut(&ReconstructObject),
+) -> Result<ReconstructBench, String> {
+    use crate::data::State;
+    use crate::render::{RenderSpec, capture_dataset};
+    use crate::synth::{generate, suite_plan};
+    let mut objects = Vec::new();
+    let mut totals = PhaseTotals::default();
+    for entry in suite_plan(true) {
+        let id = entry.id();
+        if !only.is_empty() && !only.iter().any(|o| id.contains(o.as_str())) {
+            continue;
+        }
+        let object = generate(&entry.params()).map_err(|e| format!("{id}: {e}"))?;
+        let spec = RenderSpec {
+            width: size,
+            height: size,
+            train_views: views,
+            test_views: 0,
+            seed: entry.seed,
+            ..RenderSpec::default()
+        };
+        let dataset = pollster::block_on(capture_dataset(ctx, &object, &spec))
+            .map_err(|e| format!("{id}: {e}"))?;
+        let start = Instant::now();
+        let reconstruction = pollster::block_on(crate::fit::reconstruct::reconstruct(
+            ctx,
+            &dataset,
+            config,
+            &mut |_| {},
+        ))
+        .map_err(|e| format!("{id}: {e}"))?;
+        let seconds = start.elapsed().as_secs_f64();
+        let report = crate::eval::reconstruction_report(
+            &reconstruction,
+            [
+                dataset.gt_meshes_for(State::Start),
+                dataset.gt_meshes_for(State::End),
+            ],
+            &crate::eval::ChamferOptions::default(),
+        );
+        for s in &report.states {
+            let t = &s.times;
+            totals.initialise_s += t.initialise_s;
+            totals.optimise_s += t.optimise_s;
+            totals.densify_s += t.densify_s;
+            totals.remesh_s += t.remesh_s;
+            totals.recover_s += t.recover_s;
+            totals.measure_s += t.measure_s;
+            totals.total_s += t.total_s;
+        }
+        let done = ReconstructObject {
+            id,
+            category: entry.category,
+            parts: dataset.num_parts,
+            seconds,
+            report,
+        };
+        log(&done);
+        objects.push(done);
+    }
+    let shares = [
+        ("initialise", totals.initialise_s),
+        ("optimise", totals.optimise_s),
+        ("densify", totals.densify_s),
+        ("remesh", totals.remesh_s),
+        ("recover", totals.recover_s),
+        ("measure", totals.measure_s),
+    ];
+    if let Some((name, t)) = shares.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1)) {
+        totals.dominant = name;
+        totals.dominant_share = t / totals.total_s.max(1e-9);
+    }
+    Ok(ReconstructBench {
+        bench: "reconstruct",
+        adapter: ctx.adapter.clone(),
+        preset: *config,
+        capture: CaptureSettings {
+            size,
+            train_views: views,
+        },
+        phases: totals,
+        objects,
+    })
+}

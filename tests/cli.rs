@@ -343,3 +343,77 @@ fn learn_and_bench_raster_print_json() {
         text(&bad.stderr)
     );
 }
+
+#[test]
+fn reconstruct_writes_part_meshes_and_a_report_and_refuses_bad_input() {
+    let tmp = TempDir::new("reconstruct");
+    let dir = tmp.join("obj");
+    let out = artmesh(&[
+        "synth",
+        "--category",
+        "laptop",
+        "--parts",
+        "1",
+        "--seed",
+        "1005",
+        "--out",
+        &dir,
+        "--width",
+        "32",
+        "--height",
+        "32",
+        "--train-views",
+        "4",
+        "--test-views",
+        "0",
+    ]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let before = tree(&dir);
+    let result = tmp.join("result");
+    let run = artmesh(&[
+        "reconstruct",
+        &dir,
+        "--out",
+        &result,
+        "--preset",
+        "tiny",
+        "--iterations",
+        "30",
+    ]);
+    let report = json(&run);
+    // Progress went to stderr, phase by phase.
+    let progress = text(&run.stderr);
+    for phase in ["initialise", "optimise", "remesh", "recover", "done"] {
+        assert!(progress.contains(phase), "no '{phase}' in:\n{progress}");
+    }
+    assert_eq!(report["preset"], "tiny");
+    assert_eq!(report["remesh"], "part-aware");
+    for state in report["states"].as_array().unwrap() {
+        assert_eq!(state["cross_part_faces"], 0);
+        assert_eq!(state["parts"].as_array().unwrap().len(), 2);
+        assert!(state["parts"][1]["chamfer"]["cd_mm"].as_f64().unwrap() > 0.0);
+    }
+    // The meshes are in the gt/ layout, readable as ground truth, with the report beside them.
+    let written = tree(&result);
+    let gt = GroundTruth::from_files(&written).unwrap();
+    for state in [data::State::Start, data::State::End] {
+        let meshes = gt.meshes[state.index()].as_ref().unwrap();
+        assert!(!meshes.static_part.triangles.is_empty() && meshes.movable.len() == 1);
+    }
+    assert!(written.contains_key("report.json"));
+    // The dataset is untouched; the output folder is never overwritten.
+    assert_eq!(tree(&dir), before);
+    let again = artmesh(&["reconstruct", &dir, "--out", &result, "--preset", "tiny"]);
+    assert!(!again.status.success() && text(&again.stderr).contains("not empty"));
+
+    // A dataset without depth maps: a clear error, nothing written.
+    std::fs::remove_dir_all(format!("{dir}/start/train/depth")).unwrap();
+    std::fs::remove_dir_all(format!("{dir}/end/train/depth")).unwrap();
+    let no_depth = tmp.join("no-depth");
+    let out = artmesh(&["reconstruct", &dir, "--out", &no_depth, "--preset", "tiny"]);
+    let err = text(&out.stderr);
+    assert!(!out.status.success() && err.contains("depth"), "{err}");
+    assert!(!Path::new(&no_depth).exists());
+    let bad = artmesh(&["reconstruct", &dir, "--out", &no_depth, "--preset", "huge"]);
+    assert!(!bad.status.success() && text(&bad.stderr).contains("tiny"));
+}

@@ -213,3 +213,40 @@ async fn a_short_photometric_fit_learns_in_the_browser() {
         result.psnr_end
     );
 }
+
+#[wasm_bindgen_test]
+async fn a_tiny_reconstruction_runs_in_the_browser() {
+    use artmesh::eval::mesh_quality::{reconstruction_failures, tiny_reconstruction};
+    use artmesh::fit::reconstruct::RemeshMode;
+    let ctx = context().await;
+    let (reconstruction, report) = tiny_reconstruction(&ctx, RemeshMode::PartAware)
+        .await
+        .unwrap();
+    for s in &report.states {
+        let parts: Vec<String> = s
+            .parts
+            .iter()
+            .map(|p| {
+                format!(
+                    "part {}: {} faces, {} piece(s), cd_mm {:?}",
+                    p.part,
+                    p.faces,
+                    p.components,
+                    p.chamfer.map(|c| c.cd_mm)
+                )
+            })
+            .collect();
+        console_log!(
+            "reconstruction {:?}: PSNR {:.2} / {:.2} / {:.2} dB, cross-part {}, {}",
+            s.state,
+            s.psnr_optimised,
+            s.psnr_remeshed,
+            s.psnr_recovered,
+            s.cross_part_faces,
+            parts.join("; ")
+        );
+    }
+    assert_eq!(reconstruction.states.len(), 2);
+    let failures = reconstruction_failures(&report, 25.0, 14.0);
+    assert!(failures.is_empty(), "{failures:#?}");
+}

@@ -5,6 +5,8 @@
 //!   parallel axes), Part Motion (° geodesic for revolute, m for prismatic), and the optimal type-consistent
 //!   matching of predicted to GT joints.
 //! - [`chamfer`]: area-weighted surface sampling, k-d tree nearest neighbours, `cd_peer` and `cd_mm`.
+//! - [`mesh_quality`]: per-part components, boundary / non-manifold / cross-part counts and Chamfer of a
+//!   reconstruction ([`reconstruction_report`]).
 //! - [`report`]: [`ObjectMetrics`] per object ([`evaluate_object`]), serialisable to JSON.
 //! - [`tables`]: part-count buckets (2 / 3 / 4-5 / 6+ / All, the paper's Table 1) and per-category columns (the
 //!   appendix table), as structs and Markdown.
@@ -18,6 +20,7 @@
 
 pub mod chamfer;
 pub mod joints;
+pub mod mesh_quality;
 pub mod report;
 pub mod tables;
 
@@ -28,6 +31,7 @@ pub use joints::{
     JointMatching, JointPairMetrics, Solver, axis_angle_deg, axis_line_distance, axis_pos,
     match_joints, match_joints_using, motion_error,
 };
+pub use mesh_quality::{PartQuality, ReconstructionReport, StateQuality, reconstruction_report};
 pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_object};
 pub use tables::{BenchmarkTable, ColumnSummary, PartBucket};
 

@@ -1,9 +1,14 @@
-//! Fitting: the optimisation loops that drive the rasterizer, the losses and Adam. Today this
-//! holds the photometric inner loop on its own ([`photometric`]), which proves the differentiable
-//! renderer learns; the two-phase schedule of the paper (reconstruction, remeshing, articulation)
-//! builds on it.
+//! Fitting: the optimisation loops that drive the rasterizer, the losses and Adam.
+//! [`photometric`] is the inner loop on its own (a field against posed views);
+//! [`init`] seeds a state's field from its depth maps; [`reconstruct`] is the paper's
+//! reconstruction phase per state (densify, prune, anneal, harden, part-aware remeshing,
+//! recovery). The articulation phase builds on its result.
 
+pub mod init;
 pub mod photometric;
+pub mod reconstruct;
 mod subdivide;
+mod views;
 
 pub use subdivide::{subdivide_to_edge, weld};
+pub use views::downsample_frame;

@@ -11,7 +11,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::subdivide::{subdivide_to_edge, weld};
-use crate::data::{Camera, Dataset, FileSet, Frame, Split, State};
+use crate::data::{Camera, Frame, Split, State};
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 use crate::loss::{ImageLoss, LossTerms, LossWeights, TargetImages, TargetView};
 use crate::optim::{Adam, AdamConfig, AdamGroup, ExponentialDecay};
@@ -36,6 +36,8 @@ pub struct PhotometricConfig {
     pub opacity_ramp: (f32, f32),
     /// The active SH degree rises by one every this many iterations, up to `max_sh_degree`.
     pub sh_degree_every: u32,
+    /// Active SH degree at iteration 0 (a recovery stage starts where the fit ended).
+    pub sh_degree_start: u32,
     pub max_sh_degree: u32,
     pub weights: LossWeights,
     pub background: Vec3,
@@ -55,6 +57,7 @@ impl Default for PhotometricConfig {
             gamma: (1.0, 0.02),
             opacity_ramp: (0.4, 0.7),
             sh_degree_every: 100,
+            sh_degree_start: 0,
             max_sh_degree: 3,
             weights: LossWeights::default(),
             background: Vec3::ZERO,
@@ -74,7 +77,8 @@ impl PhotometricConfig {
             gamma: g0 * (g1 / g0).powf(t),
             opacity_floor: ((t - r0) / (r1 - r0).max(1e-6)).clamp(0.0, 1.0),
             background: self.background,
-            sh_degree: (i / self.sh_degree_every.max(1)).min(self.max_sh_degree),
+            sh_degree: (self.sh_degree_start + i / self.sh_degree_every.max(1))
+                .min(self.max_sh_degree),
             ..RasterSettings::default()
         }
     }
@@ -171,6 +175,32 @@ impl FieldAdam {
         self.groups[0].set_lr(lr);
     }
 
+    /// Sets every group's learning rate.
+    pub fn set_rates(&mut self, lr: FieldLearningRates) {
+        for (group, lr) in self
+            .groups
+            .iter_mut()
+            .zip([lr.position, lr.sh, lr.opacity, lr.part])
+        {
+            group.set_lr(lr);
+        }
+    }
+
+    /// Moves the optimiser onto `field` after a topology edit: `map[new vertex] = old vertex`, or
+    /// [`crate::optim::FRESH`] for a vertex that starts with zero moments.
+    pub fn remap(&mut self, ctx: &GpuContext, field: &GpuField, map: &[u32]) -> GpuResult<()> {
+        let buffers = [
+            (&field.positions, &field.grad_positions, 4),
+            (&field.sh, &field.grad_sh, SH_FLOATS as u32),
+            (&field.opacity, &field.grad_opacity, 1),
+            (&field.part_logits, &field.grad_part_logits, field.num_parts),
+        ];
+        for (group, (params, grads, stride)) in self.groups.iter_mut().zip(buffers) {
+            self.adam.remap(ctx, group, params, grads, map, stride)?;
+        }
+        Ok(())
+    }
+
     /// Records one step of every group.
     pub fn encode_step(
         &mut self,
@@ -196,26 +226,173 @@ fn target_rgb(frame: &Frame, background: Vec3) -> Vec<f32> {
     out
 }
 
-/// Mean PSNR of `field` over `problem`'s views with `settings`.
-pub async fn mean_psnr(
-    ctx: &GpuContext,
-    raster: &Rasterizer,
-    field: &GpuField,
-    state: &mut RasterState,
-    problem: &Problem,
-    settings: &RasterSettings,
-) -> GpuResult<f64> {
-    let mut sum = 0.0;
-    for (camera, frame) in problem.cameras.iter().zip(&problem.frames) {
-        raster.forward(ctx, field, state, camera, settings).await?;
-        let render = state.read_render(ctx).await?;
-        let n = (render.width * render.height) as usize;
-        sum += crate::raster::reference::psnr(
-            &render.planes[..3 * n],
-            &target_rgb(frame, settings.background),
-        );
+/// The photometric training state of one mesh field against one set of posed views: the
+/// rasterizer, the image loss with its uploaded targets, the field on the GPU and its Adam. The
+/// photometric fit and the reconstruction phase both step it; the reconstruction also edits the
+/// topology in between ([`Trainer::replace_field`]).
+pub struct Trainer<'a> {
+    raster: Rasterizer,
+    /// The field being optimised.
+    pub field: GpuField,
+    state: RasterState,
+    loss: ImageLoss,
+    targets: TargetImages,
+    optimizer: FieldAdam,
+    cameras: &'a [Camera],
+    frames: &'a [Frame],
+    rng: Rng,
+    order: Vec<usize>,
+}
+
+impl<'a> Trainer<'a> {
+    /// Uploads `field` and the targets; errors on mismatched or empty views.
+    pub fn new(
+        ctx: &GpuContext,
+        cameras: &'a [Camera],
+        frames: &'a [Frame],
+        field: &MeshField,
+        lr: FieldLearningRates,
+        seed: u64,
+    ) -> GpuResult<Self> {
+        let Some(first) = frames.first() else {
+            return Err(GpuError::InvalidInput(
+                "a photometric fit needs at least one view".into(),
+            ));
+        };
+        if cameras.len() != frames.len() {
+            return Err(GpuError::InvalidInput(format!(
+                "{} cameras for {} frames",
+                cameras.len(),
+                frames.len()
+            )));
+        }
+        let (w, h) = (first.rgba.width, first.rgba.height);
+        let parts = field.num_parts as u32;
+        let gpu_field = GpuField::upload(ctx, field)?;
+        let views: Vec<TargetView> = frames.iter().map(TargetView::from).collect();
+        Ok(Self {
+            raster: Rasterizer::new(ctx),
+            state: RasterState::new(ctx, w, h, parts)?,
+            loss: ImageLoss::new(ctx, w, h, parts)?,
+            targets: TargetImages::upload(ctx, w, h, &views)?,
+            optimizer: FieldAdam::new(ctx, &gpu_field, lr)?,
+            field: gpu_field,
+            cameras,
+            frames,
+            rng: Rng::new(seed),
+            order: Vec::new(),
+        })
     }
-    Ok(sum / problem.cameras.len().max(1) as f64)
+
+    /// The optimiser, for learning-rate schedules.
+    pub fn optimizer(&mut self) -> &mut FieldAdam {
+        &mut self.optimizer
+    }
+
+    /// One step on the next view of a shuffled cycle through all views.
+    pub async fn step(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RasterSettings,
+        weights: &LossWeights,
+    ) -> GpuResult<()> {
+        if self.order.is_empty() {
+            self.order = (0..self.cameras.len()).collect();
+            for k in (1..self.order.len()).rev() {
+                self.order.swap(k, self.rng.below(k as u32 + 1) as usize);
+            }
+        }
+        let view = self.order.pop().unwrap_or(0);
+        self.raster
+            .forward(
+                ctx,
+                &self.field,
+                &mut self.state,
+                &self.cameras[view],
+                settings,
+            )
+            .await?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.loss.encode(
+            ctx,
+            &mut encoder,
+            self.state.render(),
+            &self.targets,
+            view,
+            weights,
+            settings.background.to_array(),
+            self.state.grad_render(),
+        )?;
+        self.raster
+            .encode_backward(ctx, &mut encoder, &self.field, &mut self.state);
+        self.optimizer.encode_step(ctx, &mut encoder)?;
+        ctx.queue.submit([encoder.finish()]);
+        Ok(())
+    }
+
+    /// The loss terms of the last step; an error when they are not finite.
+    pub async fn read_terms(&self, ctx: &GpuContext, iteration: u32) -> GpuResult<LossTerms> {
+        let terms = self.loss.read_terms(ctx).await?;
+        if !terms.total.is_finite() {
+            return Err(GpuError::InvalidInput(format!(
+                "the loss became {} at iteration {iteration}: lower the learning rates",
+                terms.total
+            )));
+        }
+        Ok(terms)
+    }
+
+    /// Mean PSNR over all views with `settings`.
+    pub async fn mean_psnr(
+        &mut self,
+        ctx: &GpuContext,
+        settings: &RasterSettings,
+    ) -> GpuResult<f64> {
+        let mut sum = 0.0;
+        for (camera, frame) in self.cameras.iter().zip(self.frames) {
+            self.raster
+                .forward(ctx, &self.field, &mut self.state, camera, settings)
+                .await?;
+            let render = self.state.read_render(ctx).await?;
+            let n = (render.width * render.height) as usize;
+            sum += crate::raster::reference::psnr(
+                &render.planes[..3 * n],
+                &target_rgb(frame, settings.background),
+            );
+        }
+        Ok(sum / self.cameras.len().max(1) as f64)
+    }
+
+    /// Zeroes the per-face statistics (max blending weight, pixel count) the renders accumulate.
+    pub fn clear_face_stats(&self, ctx: &GpuContext) {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.state.clear_face_stats(&mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+    }
+
+    /// Per face (max blending weight, pixels covered) since the last clear.
+    pub async fn read_face_stats(&self, ctx: &GpuContext) -> GpuResult<Vec<(f32, u32)>> {
+        self.state.read_face_stats(ctx, self.field.num_faces).await
+    }
+
+    /// The field as it is now.
+    pub async fn download(&self, ctx: &GpuContext) -> GpuResult<MeshField> {
+        self.field.download(ctx).await
+    }
+
+    /// Replaces the field after a topology edit, carrying Adam's moments along `map`
+    /// (`map[new vertex] = old vertex` or [`crate::optim::FRESH`]).
+    pub fn replace_field(
+        &mut self,
+        ctx: &GpuContext,
+        field: &MeshField,
+        map: &[u32],
+    ) -> GpuResult<()> {
+        let gpu_field = GpuField::upload(ctx, field)?;
+        self.optimizer.remap(ctx, &gpu_field, map)?;
+        self.field = gpu_field;
+        Ok(())
+    }
 }
 
 /// Fits `problem.field` to `problem.frames`; `progress` hears every reported curve point.
@@ -225,115 +402,80 @@ pub async fn fit(
     config: &PhotometricConfig,
     progress: &mut dyn FnMut(&CurvePoint),
 ) -> GpuResult<PhotometricResult> {
-    let Some(first) = problem.frames.first() else {
-        return Err(GpuError::InvalidInput(
-            "a photometric fit needs at least one view".into(),
-        ));
-    };
-    if problem.cameras.len() != problem.frames.len() {
-        return Err(GpuError::InvalidInput(format!(
-            "{} cameras for {} frames",
-            problem.cameras.len(),
-            problem.frames.len()
-        )));
-    }
-    let (w, h) = (first.rgba.width, first.rgba.height);
-    let parts = problem.field.num_parts as u32;
-    let raster = Rasterizer::new(ctx);
-    let field = GpuField::upload(ctx, &problem.field)?;
-    let mut state = RasterState::new(ctx, w, h, parts)?;
-    let loss = ImageLoss::new(ctx, w, h, parts)?;
-    let views: Vec<TargetView> = problem.frames.iter().map(TargetView::from).collect();
-    let targets = TargetImages::upload(ctx, w, h, &views)?;
     let position_decay = ExponentialDecay {
         start: config.position_lr.0,
         end: config.position_lr.1,
         steps: config.iterations,
     };
-    let mut optimizer = FieldAdam::new(
+    let mut trainer = Trainer::new(
         ctx,
-        &field,
-        FieldLearningRates {
-            position: position_decay.lr(0),
-            sh: config.sh_lr,
-            opacity: config.opacity_lr,
-            part: config.part_lr,
-        },
+        &problem.cameras,
+        &problem.frames,
+        &problem.field,
+        config.rates(position_decay.lr(0)),
+        config.seed,
     )?;
-
-    let psnr_start = mean_psnr(
-        ctx,
-        &raster,
-        &field,
-        &mut state,
-        problem,
-        &config.settings_at(0),
-    )
-    .await?;
-    let mut rng = Rng::new(config.seed);
-    let mut order: Vec<usize> = Vec::new();
+    let psnr_start = trainer.mean_psnr(ctx, &config.settings_at(0)).await?;
     let mut curve = Vec::new();
-    let background = config.background.to_array();
     for i in 0..config.iterations {
-        if order.is_empty() {
-            order = (0..problem.cameras.len()).collect();
-            for k in (1..order.len()).rev() {
-                order.swap(k, rng.below(k as u32 + 1) as usize);
-            }
-        }
-        let view = order.pop().unwrap_or(0);
         let settings = config.settings_at(i);
-        raster
-            .forward(ctx, &field, &mut state, &problem.cameras[view], &settings)
-            .await?;
-        let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        loss.encode(
-            ctx,
-            &mut encoder,
-            state.render(),
-            &targets,
-            view,
-            &config.weights,
-            background,
-            state.grad_render(),
-        )?;
-        raster.encode_backward(ctx, &mut encoder, &field, &mut state);
-        optimizer.set_position_lr(position_decay.lr(i));
-        optimizer.encode_step(ctx, &mut encoder)?;
-        ctx.queue.submit([encoder.finish()]);
-        let last = i + 1 == config.iterations;
-        if i % config.report_every.max(1) == 0 || last {
-            let terms = loss.read_terms(ctx).await?;
-            if !terms.total.is_finite() {
-                return Err(GpuError::InvalidInput(format!(
-                    "the loss became {} at iteration {i}: lower the learning rates",
-                    terms.total
-                )));
-            }
-            let psnr = if last || i % (4 * config.report_every.max(1)) == 0 {
-                Some(mean_psnr(ctx, &raster, &field, &mut state, problem, &settings).await?)
-            } else {
-                None
-            };
-            let point = CurvePoint {
-                iteration: i,
-                loss: terms,
-                psnr,
-                gamma: settings.gamma,
-                opacity_floor: settings.opacity_floor,
-            };
+        trainer.optimizer().set_position_lr(position_decay.lr(i));
+        trainer.step(ctx, &settings, &config.weights).await?;
+        if let Some(point) = config.report(ctx, &mut trainer, i, &settings).await? {
             progress(&point);
             curve.push(point);
         }
     }
-    let final_settings = config.settings_at(config.iterations);
-    let psnr_end = mean_psnr(ctx, &raster, &field, &mut state, problem, &final_settings).await?;
+    let psnr_end = trainer
+        .mean_psnr(ctx, &config.settings_at(config.iterations))
+        .await?;
     Ok(PhotometricResult {
-        field: field.download(ctx).await?,
+        field: trainer.download(ctx).await?,
         curve,
         psnr_start,
         psnr_end,
     })
+}
+
+impl PhotometricConfig {
+    /// The learning rates at the start, with `position` for the scheduled group.
+    pub fn rates(&self, position: f32) -> FieldLearningRates {
+        FieldLearningRates {
+            position,
+            sh: self.sh_lr,
+            opacity: self.opacity_lr,
+            part: self.part_lr,
+        }
+    }
+
+    /// The curve point of iteration `i` when it is a reporting iteration (loss terms every
+    /// `report_every`, mean PSNR every fourth report and at the end).
+    pub async fn report(
+        &self,
+        ctx: &GpuContext,
+        trainer: &mut Trainer<'_>,
+        i: u32,
+        settings: &RasterSettings,
+    ) -> GpuResult<Option<CurvePoint>> {
+        let every = self.report_every.max(1);
+        let last = i + 1 == self.iterations;
+        if !i.is_multiple_of(every) && !last {
+            return Ok(None);
+        }
+        let loss = trainer.read_terms(ctx, i).await?;
+        let psnr = if last || i.is_multiple_of(4 * every) {
+            Some(trainer.mean_psnr(ctx, settings).await?)
+        } else {
+            None
+        };
+        Ok(Some(CurvePoint {
+            iteration: i,
+            loss,
+            psnr,
+            gamma: settings.gamma,
+            opacity_floor: settings.opacity_floor,
+        }))
+    }
 }
 
 /// How to build a [`synthetic_scene`].
@@ -370,7 +512,7 @@ impl Default for SceneSpec {
 /// A procedural object captured at its start state from `spec.views` views, and a starting mesh
 /// made from its ground-truth surface (see the module docs).
 pub async fn synthetic_scene(ctx: &GpuContext, spec: &SceneSpec) -> Result<Problem, String> {
-    use crate::render::{RenderSpec, render_dataset};
+    use crate::render::RenderSpec;
     use crate::synth::{SynthParams, generate};
     let object = generate(&SynthParams {
         category: spec.category,
@@ -385,20 +527,7 @@ pub async fn synthetic_scene(ctx: &GpuContext, spec: &SceneSpec) -> Result<Probl
         seed: spec.seed,
         ..RenderSpec::default()
     };
-    let mut files = FileSet::new();
-    render_dataset(
-        ctx,
-        &object,
-        &render,
-        &mut |batch| {
-            files.extend(batch);
-            Ok(())
-        },
-        &mut |_| {},
-    )
-    .await
-    .map_err(|e| e.to_string())?;
-    let dataset = Dataset::from_files(&files).map_err(|e| e.to_string())?;
+    let dataset = crate::render::capture_dataset(ctx, &object, &render).await?;
     let frames = dataset
         .views(State::Start, Split::Train)
         .map(|v| v.frames.clone())

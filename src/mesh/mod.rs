@@ -1,7 +1,9 @@
-//! Mesh operations of the reconstruction phase. So far: part-aware restricted Delaunay
-//! remeshing ([`restricted_delaunay`], [`part_aware_remesh`]); densification, pruning and mesh
-//! quality reports follow with the reconstruction phase.
+//! Mesh operations of the reconstruction phase, on the CPU copy of the mesh field: part-aware
+//! restricted Delaunay remeshing ([`restricted_delaunay`], [`part_aware_remesh`]) and the topology
+//! edits around it (densification splits, pruning, hardening, connectivity counts).
 
 mod restricted_delaunay;
+pub mod topology;
 
 pub use restricted_delaunay::{RemeshOptions, part_aware_remesh, restricted_delaunay};
+pub use topology::{EdgeCounts, edge_counts, face_components, harden_parts, part_meshes};

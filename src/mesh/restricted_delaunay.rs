@@ -13,7 +13,7 @@ use glam::{DVec2, Vec3};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
 /// Knobs of [`restricted_delaunay`].
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct RemeshOptions {
     /// Neighbours per vertex (the umbrella is built from these).
     pub neighbours: usize,
@@ -293,41 +293,10 @@ mod tests {
     use super::*;
     use crate::rng::Rng;
 
-    fn edge_counts(faces: &[[u32; 3]]) -> HashMap<(u32, u32), usize> {
-        let mut count = HashMap::new();
-        for f in faces {
-            for i in 0..3 {
-                let (a, b) = (f[i], f[(i + 1) % 3]);
-                *count.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
-        count
-    }
+    use crate::mesh::topology::{edge_counts, face_components};
 
-    fn components(n: usize, faces: &[[u32; 3]]) -> usize {
-        let mut parent: Vec<usize> = (0..n).collect();
-        fn root(p: &mut [usize], mut x: usize) -> usize {
-            while p[x] != x {
-                p[x] = p[p[x]];
-                x = p[x];
-            }
-            x
-        }
-        for f in faces {
-            for i in 0..3 {
-                let (a, b) = (
-                    root(&mut parent, f[i] as usize),
-                    root(&mut parent, f[(i + 1) % 3] as usize),
-                );
-                parent[a] = b;
-            }
-        }
-        let used: std::collections::HashSet<usize> = faces
-            .iter()
-            .flatten()
-            .map(|&v| root(&mut parent, v as usize))
-            .collect();
-        used.len()
+    fn components(_n: usize, faces: &[[u32; 3]]) -> usize {
+        face_components(faces).1
     }
 
     fn longest_edge(p: &[Vec3], faces: &[[u32; 3]]) -> f32 {
@@ -361,7 +330,7 @@ mod tests {
     }
 
     fn assert_manifold(faces: &[[u32; 3]]) {
-        let bad = edge_counts(faces).values().filter(|&&c| c > 2).count();
+        let bad = edge_counts(faces).non_manifold;
         assert_eq!(bad, 0, "{bad} edges with more than two faces");
     }
 
@@ -396,14 +365,15 @@ mod tests {
         assert_manifold(&faces);
         assert_eq!(components(n, &faces), 1);
         let counts = edge_counts(&faces);
-        let closed = counts.values().filter(|&&c| c == 2).count() as f32 / counts.len() as f32;
+        let closed =
+            (counts.edges - counts.boundary - counts.non_manifold) as f32 / counts.edges as f32;
         assert!(
             closed > 0.97,
             "{:.1} % of edges have two faces",
             100.0 * closed
         );
         // Euler characteristic of a sphere, up to a few small holes.
-        let euler = n as i64 - counts.len() as i64 + faces.len() as i64;
+        let euler = n as i64 - counts.edges as i64 + faces.len() as i64;
         assert!((euler - 2).abs() <= 6, "V − E + F = {euler}");
     }
 

@@ -272,6 +272,29 @@ pub struct RenderProgress {
     pub total: usize,
 }
 
+/// Renders the two-state dataset of `obj` in memory and reads it back as a [`Dataset`] (what a
+/// user would drop in), for tests and the browser demo.
+pub async fn capture_dataset(
+    ctx: &GpuContext,
+    obj: &ArticulatedObject,
+    spec: &RenderSpec,
+) -> Result<crate::data::Dataset, String> {
+    let mut files = FileSet::new();
+    render_dataset(
+        ctx,
+        obj,
+        spec,
+        &mut |batch| {
+            files.extend(batch);
+            Ok(())
+        },
+        &mut |_| {},
+    )
+    .await
+    .map_err(|e| e.to_string())?;
+    crate::data::Dataset::from_files(&files).map_err(|e| e.to_string())
+}
+
 /// Renders the two-state dataset of `obj` (see the module docs). Every batch of files — one frame's images,
 /// then the transforms files and ground truth — goes to `sink` as soon as it is ready; `progress` hears about
 /// every frame.

@@ -23,7 +23,7 @@ mod sheet;
 
 pub use dataset::{
     CaptureTruth, DatasetRenderError, MIN_OBJECT_SIZE, ObjectProblem, RenderProgress, RenderSpec,
-    RenderedDataset, capture_truth, render_dataset,
+    RenderedDataset, capture_dataset, capture_truth, render_dataset,
 };
 pub use sheet::{SheetEntry, contact_sheet, overview_camera};
 
