@@ -2,10 +2,10 @@
 # The README's main-job command. Today: generates the built-in default object (a procedural
 # StorageFurniture cabinet with three drawers and two doors, seed 4), captures it as a two-state RGB-D dataset
 # with part maps and ground truth, checks the dataset with `artmesh info`, scores the ground truth
-# against itself with `artmesh eval` (all zeros), runs the GPU self-test, and runs the differentiable
-# rasterizer's learning driver (`artmesh learn`: a jittered grey copy of a procedural box fitted to 8 views
-# at 64x64, printing the loss and PSNR as it goes). The full fit joins once the reconstruction and
-# articulation phases land. Usage: scripts/demo.sh [OUTPUT_DIR]
+# against itself with `artmesh eval` (all zeros), runs the GPU self-test, and runs the reconstruction
+# phase on it (`artmesh reconstruct --preset fast`: per state a part-aware mesh from 12 views at 57x57,
+# with a progress bar, writing one PLY per part and state and a quality report with Chamfer to the
+# ground truth). The articulation phase joins with its issue. Usage: scripts/demo.sh [OUTPUT_DIR]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/setup.sh --native
@@ -19,6 +19,6 @@ target/release/artmesh synth --category storage --parts 5 --seed 4 --out "$out" 
 target/release/artmesh info "$out"
 target/release/artmesh eval "$out" "$out" --samples 2000 | grep -E '"(axis_ang|axis_pos|part_motion)"' | sort | uniq -c
 target/release/artmesh gpu
-target/release/artmesh learn --size 64 --views 8 --iterations 150 > "$out.learn.json"
-grep -E '"psnr_(start|end)"' "$out.learn.json"
-echo "dataset in $out (object as URDF in $out/object); learning curve in $out.learn.json"
+target/release/artmesh reconstruct "$out" --out "$out.reconstruction" --preset fast > /dev/null
+grep -E '"(cross_part_faces|components|cd_mm|psnr_recovered)"' "$out.reconstruction/report.json" | sort | uniq -c
+echo "dataset in $out (object as URDF in $out/object); part meshes and report.json in $out.reconstruction"

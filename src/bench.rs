@@ -400,13 +400,7 @@ pub struct ReconstructObject {
 /// Time per phase summed over all objects and both states.
 #[derive(Debug, Clone, Copy, Default, Serialize)]
 pub struct PhaseTotals {
-    pub initialise_s: f64,
-    pub optimise_s: f64,
-    pub densify_s: f64,
-    pub remesh_s: f64,
-    pub recover_s: f64,
-    pub measure_s: f64,
-    pub total_s: f64,
+    pub seconds: crate::fit::reconstruct::PhaseTimes,
     /// The phase with the largest share, and that share.
     pub dominant: &'static str,
     pub dominant_share: f64,
@@ -479,14 +473,7 @@ pub fn reconstruct(
             &crate::eval::ChamferOptions::default(),
         );
         for s in &report.states {
-            let t = &s.times;
-            totals.initialise_s += t.initialise_s;
-            totals.optimise_s += t.optimise_s;
-            totals.densify_s += t.densify_s;
-            totals.remesh_s += t.remesh_s;
-            totals.recover_s += t.recover_s;
-            totals.measure_s += t.measure_s;
-            totals.total_s += t.total_s;
+            totals.seconds.accumulate(&s.times);
         }
         let done = ReconstructObject {
             id,
@@ -498,18 +485,7 @@ pub fn reconstruct(
         log(&done);
         objects.push(done);
     }
-    let shares = [
-        ("initialise", totals.initialise_s),
-        ("optimise", totals.optimise_s),
-        ("densify", totals.densify_s),
-        ("remesh", totals.remesh_s),
-        ("recover", totals.recover_s),
-        ("measure", totals.measure_s),
-    ];
-    if let Some((name, t)) = shares.iter().copied().max_by(|a, b| a.1.total_cmp(&b.1)) {
-        totals.dominant = name;
-        totals.dominant_share = t / totals.total_s.max(1e-9);
-    }
+    (totals.dominant, totals.dominant_share) = totals.seconds.dominant();
     Ok(ReconstructBench {
         bench: "reconstruct",
         adapter: ctx.adapter.clone(),

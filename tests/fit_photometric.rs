@@ -3,14 +3,10 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::fit::photometric::{self, PhotometricConfig, SceneSpec};
-use artmesh::gpu::GpuContext;
 
-fn context() -> GpuContext {
-    match pollster::block_on(GpuContext::new()) {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("GPU tests need an adapter: {e}"),
-    }
-}
+mod common;
+
+use common::context;
 
 fn run(spec: SceneSpec, config: PhotometricConfig) -> photometric::PhotometricResult {
     let ctx = context();

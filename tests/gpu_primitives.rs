@@ -2,14 +2,11 @@
 //! CPU results from 1 to 4M elements, the 2-D dispatch tiling path, and limit errors.
 #![cfg(not(target_arch = "wasm32"))]
 
-use artmesh::gpu::{GpuContext, GpuError, PrefixSum, RadixSort, selftest};
+use artmesh::gpu::{GpuError, PrefixSum, RadixSort, selftest};
 
-fn context() -> GpuContext {
-    match pollster::block_on(GpuContext::new()) {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("GPU tests need an adapter: {e}"),
-    }
-}
+mod common;
+
+use common::context;
 
 fn assert_all_pass(checks: &[selftest::PrimitiveCheck]) {
     let failed: Vec<_> = checks.iter().filter(|c| !c.passed()).collect();

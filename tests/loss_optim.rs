@@ -4,16 +4,13 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::data::{DepthMap, PartMap, RgbaImage};
-use artmesh::gpu::{GpuContext, GpuError, fma_peak};
+use artmesh::gpu::{GpuError, fma_peak};
 use artmesh::loss::{ImageLoss, LossWeights, TargetImages, TargetView, check, render_channels};
 use artmesh::optim::{Adam, AdamConfig, ExponentialDecay, check as adam_check};
 
-fn context() -> GpuContext {
-    match pollster::block_on(GpuContext::new()) {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("GPU tests need an adapter: {e}"),
-    }
-}
+mod common;
+
+use common::context;
 
 /// 23×17: no dimension or pixel count is a multiple of the 256-invocation workgroup.
 const W: u32 = 23;

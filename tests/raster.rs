@@ -3,15 +3,11 @@
 //! group, and buffer limits that give clear errors.
 #![cfg(not(target_arch = "wasm32"))]
 
-use artmesh::gpu::GpuContext;
 use artmesh::raster::check;
 
-fn context() -> GpuContext {
-    match pollster::block_on(GpuContext::new()) {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("GPU tests need an adapter: {e}"),
-    }
-}
+mod common;
+
+use common::context;
 
 #[test]
 fn forward_matches_cpu_reference() {

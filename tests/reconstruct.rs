@@ -5,15 +5,11 @@
 
 use artmesh::eval::mesh_quality::{reconstruction_failures, tiny_reconstruction};
 use artmesh::fit::reconstruct::RemeshMode;
-use artmesh::gpu::GpuContext;
 use artmesh::mesh::topology::cross_part_faces;
 
-fn context() -> GpuContext {
-    match pollster::block_on(GpuContext::new()) {
-        Ok(ctx) => ctx,
-        Err(e) => panic!("GPU tests need an adapter: {e}"),
-    }
-}
+mod common;
+
+use common::context;
 
 #[test]
 fn a_tiny_two_part_reconstruction_is_part_aware_and_near_the_ground_truth() {

@@ -363,6 +363,28 @@ impl<'a> Trainer<'a> {
         Ok(sum / self.cameras.len().max(1) as f64)
     }
 
+    /// Runs `config`'s whole schedule (γ, opacity floor, SH degree, decaying position rate) on
+    /// the current topology; `progress` hears every reported curve point, which are returned.
+    pub async fn run(
+        &mut self,
+        ctx: &GpuContext,
+        config: &PhotometricConfig,
+        progress: &mut dyn FnMut(&CurvePoint),
+    ) -> GpuResult<Vec<CurvePoint>> {
+        let decay = config.position_decay();
+        let mut curve = Vec::new();
+        for i in 0..config.iterations {
+            let settings = config.settings_at(i);
+            self.optimizer.set_position_lr(decay.lr(i));
+            self.step(ctx, &settings, &config.weights).await?;
+            if let Some(point) = config.report(ctx, self, i, &settings).await? {
+                progress(&point);
+                curve.push(point);
+            }
+        }
+        Ok(curve)
+    }
+
     /// Zeroes the per-face statistics (max blending weight, pixel count) the renders accumulate.
     pub fn clear_face_stats(&self, ctx: &GpuContext) {
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
@@ -402,30 +424,16 @@ pub async fn fit(
     config: &PhotometricConfig,
     progress: &mut dyn FnMut(&CurvePoint),
 ) -> GpuResult<PhotometricResult> {
-    let position_decay = ExponentialDecay {
-        start: config.position_lr.0,
-        end: config.position_lr.1,
-        steps: config.iterations,
-    };
     let mut trainer = Trainer::new(
         ctx,
         &problem.cameras,
         &problem.frames,
         &problem.field,
-        config.rates(position_decay.lr(0)),
+        config.rates(config.position_lr.0),
         config.seed,
     )?;
     let psnr_start = trainer.mean_psnr(ctx, &config.settings_at(0)).await?;
-    let mut curve = Vec::new();
-    for i in 0..config.iterations {
-        let settings = config.settings_at(i);
-        trainer.optimizer().set_position_lr(position_decay.lr(i));
-        trainer.step(ctx, &settings, &config.weights).await?;
-        if let Some(point) = config.report(ctx, &mut trainer, i, &settings).await? {
-            progress(&point);
-            curve.push(point);
-        }
-    }
+    let curve = trainer.run(ctx, config, progress).await?;
     let psnr_end = trainer
         .mean_psnr(ctx, &config.settings_at(config.iterations))
         .await?;
@@ -438,6 +446,15 @@ pub async fn fit(
 }
 
 impl PhotometricConfig {
+    /// The position learning rate's log-linear decay over the run.
+    pub fn position_decay(&self) -> ExponentialDecay {
+        ExponentialDecay {
+            start: self.position_lr.0,
+            end: self.position_lr.1,
+            steps: self.iterations,
+        }
+    }
+
     /// The learning rates at the start, with `position` for the scheduled group.
     pub fn rates(&self, position: f32) -> FieldLearningRates {
         FieldLearningRates {

@@ -29,7 +29,6 @@ use crate::mesh::topology::{
 use crate::mesh::{
     RemeshOptions, harden_parts, part_aware_remesh, part_meshes, restricted_delaunay,
 };
-use crate::optim::ExponentialDecay;
 use crate::raster::MeshField;
 
 /// Named budgets: `tiny` for tests, `fast` for the CPU demo, `paper` for the paper's setting.
@@ -319,6 +318,49 @@ pub struct PhaseTimes {
     /// PSNR measurements over all views between stages.
     pub measure_s: f64,
     pub total_s: f64,
+}
+
+impl PhaseTimes {
+    /// Adds `other`'s seconds to these.
+    pub fn accumulate(&mut self, other: &PhaseTimes) {
+        for (mine, theirs) in self.phases_mut().into_iter().zip(other.phases()) {
+            *mine.1 += theirs.1;
+        }
+        self.total_s += other.total_s;
+    }
+
+    /// (phase, seconds) without the total.
+    pub fn phases(&self) -> [(&'static str, f64); 6] {
+        [
+            ("initialise", self.initialise_s),
+            ("optimise", self.optimise_s),
+            ("densify", self.densify_s),
+            ("remesh", self.remesh_s),
+            ("recover", self.recover_s),
+            ("measure", self.measure_s),
+        ]
+    }
+
+    fn phases_mut(&mut self) -> [(&'static str, &mut f64); 6] {
+        [
+            ("initialise", &mut self.initialise_s),
+            ("optimise", &mut self.optimise_s),
+            ("densify", &mut self.densify_s),
+            ("remesh", &mut self.remesh_s),
+            ("recover", &mut self.recover_s),
+            ("measure", &mut self.measure_s),
+        ]
+    }
+
+    /// The phase with the largest share of the total, and that share.
+    pub fn dominant(&self) -> (&'static str, f64) {
+        let (name, t) = self
+            .phases()
+            .into_iter()
+            .max_by(|a, b| a.1.total_cmp(&b.1))
+            .unwrap_or(("none", 0.0));
+        (name, t / self.total_s.max(1e-9))
+    }
 }
 
 /// What the remeshing step did.
@@ -642,11 +684,7 @@ pub async fn reconstruct_state(
 
     // Optimisation with densification and pruning.
     let fit = &config.fit;
-    let decay = ExponentialDecay {
-        start: fit.position_lr.0,
-        end: fit.position_lr.1,
-        steps: fit.iterations,
-    };
+    let decay = fit.position_decay();
     let mut trainer = Trainer::new(
         ctx,
         &cameras,
@@ -732,36 +770,28 @@ pub async fn reconstruct_state(
 
     // Recovery with fixed topology.
     let recovery = config.recovery();
-    let decay = ExponentialDecay {
-        start: recovery.position_lr.0,
-        end: recovery.position_lr.1,
-        steps: recovery.iterations,
-    };
     let mut trainer = Trainer::new(
         ctx,
         &cameras,
         frames,
         &remeshed,
-        recovery.rates(decay.lr(0)),
+        recovery.rates(recovery.position_lr.0),
         fit.seed ^ 1,
     )?;
     let psnr_remeshed = trainer.mean_psnr(ctx, &recovery.settings_at(0)).await?;
     times.measure_s += lap();
-    for i in 0..recovery.iterations {
-        let settings = recovery.settings_at(i);
-        trainer.optimizer().set_position_lr(decay.lr(i));
-        trainer.step(ctx, &settings, &recovery.weights).await?;
-        if let Some(point) = recovery.report(ctx, &mut trainer, i, &settings).await? {
+    trainer
+        .run(ctx, &recovery, &mut |point| {
             progress(&event(
                 Phase::Recover,
-                i + 1,
+                point.iteration + 1,
                 recovery.iterations,
                 Some(point.loss.total),
                 point.psnr,
                 sizes,
-            ));
-        }
-    }
+            ))
+        })
+        .await?;
     times.recover_s = lap();
     let psnr_recovered = trainer
         .mean_psnr(ctx, &recovery.settings_at(recovery.iterations))
