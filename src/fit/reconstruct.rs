@@ -23,8 +23,8 @@ use super::views::downsample_frame;
 use crate::data::{Camera, Dataset, Frame, GroundTruth, GtMeshes, Split, State, TriMesh};
 use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
 use crate::mesh::topology::{
-    compact, cross_part_faces, drop_small_components, face_part, gather_vertices, median_edge,
-    retain_faces, split_faces, thin_vertices, vertex_normals,
+    compact, cross_part_faces, drop_small_components, face_part, median_edge, retain_faces,
+    split_faces, thin_vertices, vertex_normals,
 };
 use crate::mesh::{
     RemeshOptions, harden_parts, part_aware_remesh, part_meshes, restricted_delaunay,
@@ -569,18 +569,17 @@ fn remesh(field: &MeshField, config: &ReconstructionConfig) -> (MeshField, Remes
     };
     // Only vertices the optimised faces still use take part, thinned to an even spacing of
     // about one median edge: the soup's vertices come in tight clusters, which would leave the
-    // restricted Delaunay step holes and slivers.
+    // restricted Delaunay step holes and slivers. Thinning never mixes parts.
     let (used, used_map) = compact(field, field.faces.clone());
     let used_parts: Vec<u32> = used_map.iter().map(|&v| parts[v as usize]).collect();
     let used_normals: Vec<Vec3> = used_map.iter().map(|&v| normals[v as usize]).collect();
     let cell = config.remesh_spacing * median_edge(&used.positions, &used.faces);
-    let (chosen, used_normals) = if cell > 0.0 {
-        thin_vertices(&used.positions, &used_normals, &used_parts, cell)
+    let (used, used_normals) = if cell > 0.0 {
+        thin_vertices(&used, &used_normals, &used_parts, cell)
     } else {
-        ((0..used.num_vertices() as u32).collect(), used_normals)
+        (used, used_normals)
     };
-    let used = gather_vertices(&used, &chosen, Vec::new());
-    let used_parts: Vec<u32> = chosen.iter().map(|&v| used_parts[v as usize]).collect();
+    let used_parts = harden_parts(&used);
     let faces = match config.remesh {
         RemeshMode::PartAware => part_aware_remesh(
             &used.positions,

@@ -170,10 +170,14 @@ pub fn restricted_delaunay(
         }
         let mut patch: Vec<Vec3> = near.iter().map(|&j| points[j as usize]).collect();
         patch.push(points[i]);
-        let Some(mut n) = own
-            .filter(|n| n.length_squared() > 0.0)
-            .or_else(|| plane_normal(&patch))
-        else {
+        // The tangent plane is fitted to the patch (optimised vertices' own normals are noisy);
+        // the vertex normal only picks its side.
+        let own = own.filter(|n| n.length_squared() > 0.0);
+        let Some(mut n) = (match (plane_normal(&patch), own) {
+            (Some(p), Some(o)) if p.dot(o) < 0.0 => Some(-p),
+            (Some(p), _) => Some(p),
+            (None, o) => o,
+        }) else {
             continue;
         };
         n = n.normalize();
@@ -234,21 +238,23 @@ pub fn restricted_delaunay(
             votes.entry(key).or_insert((0, oriented)).0 += 1;
         }
     }
-    accept_votes(votes)
+    accept_votes(votes, points)
 }
 
-/// Keeps triangles proposed by all three vertices, then adds two-vote triangles that leave every
-/// edge with at most two faces.
-fn accept_votes(votes: HashMap<[u32; 3], (u32, [u32; 3])>) -> Vec<[u32; 3]> {
+/// Keeps triangles proposed by all three vertices, then two-vote triangles that leave every
+/// edge with at most two faces, then one-vote triangles that close holes.
+fn accept_votes(votes: HashMap<[u32; 3], (u32, [u32; 3])>, points: &[Vec3]) -> Vec<[u32; 3]> {
     let mut ranked: Vec<([u32; 3], u32, [u32; 3])> =
         votes.into_iter().map(|(k, (n, f))| (k, n, f)).collect();
     ranked.sort_by(|a, b| b.1.cmp(&a.1).then(a.0.cmp(&b.0)));
     let mut edge_use: HashMap<(u32, u32), u32> = HashMap::new();
     let edge = |a: u32, b: u32| if a < b { (a, b) } else { (b, a) };
     let mut faces = Vec::new();
+    let mut single = Vec::new();
     for (_, count, f) in ranked {
         if count < 2 {
-            break;
+            single.push(f);
+            continue;
         }
         let edges = [edge(f[0], f[1]), edge(f[1], f[2]), edge(f[2], f[0])];
         if edges
@@ -261,6 +267,30 @@ fn accept_votes(votes: HashMap<[u32; 3], (u32, [u32; 3])>) -> Vec<[u32; 3]> {
             *edge_use.entry(e).or_default() += 1;
         }
         faces.push(f);
+    }
+    // Where neighbouring umbrellas disagreed a hole is left; a one-vote triangle that closes it
+    // (two or three of its edges already on the hole's rim, none overused, no edge longer than
+    // twice the accepted faces' median) fills it. Two rounds: a filled notch can expose the next.
+    let longest = |f: &[u32; 3]| {
+        let [a, b, c] = f.map(|v| points[v as usize]);
+        a.distance(b).max(b.distance(c)).max(c.distance(a))
+    };
+    let limit = 2.0 * crate::mesh::topology::median_edge(points, &faces);
+    for _ in 0..2 {
+        single.retain(|f| {
+            let edges = [edge(f[0], f[1]), edge(f[1], f[2]), edge(f[2], f[0])];
+            let uses = edges.map(|e| edge_use.get(&e).copied().unwrap_or(0));
+            let fills = uses.iter().all(|&u| u < 2)
+                && uses.iter().filter(|&&u| u == 1).count() >= 2
+                && longest(f) <= limit;
+            if fills {
+                for e in edges {
+                    *edge_use.entry(e).or_default() += 1;
+                }
+                faces.push(*f);
+            }
+            !fills
+        });
     }
     faces
 }

@@ -251,20 +251,41 @@ pub fn median_edge(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
     *lengths.select_nth_unstable_by(mid, f32::total_cmp).1
 }
 
-/// Picks an evenly spread subset of vertices: per (voxel of side `cell`, part) the vertex
-/// nearest the voxel's mean. Returns the chosen vertices and, per chosen vertex, the mean of its
-/// voxel's normals (a smoothed normal for the tangent planes). Chosen vertices are not moved.
+/// Thins vertices to an even spacing: one representative per (voxel of side `cell`, part, normal
+/// side), the
+/// vertex nearest the voxel's mean, which keeps its position. It takes the voxel's mean colour,
+/// opacity and part logits (one soup vertex's colour is noisy; their mean is the surface's), and
+/// the mean of the voxel's `normals` (a smoothed normal for the tangent planes). Returns the thinned
+/// field (no faces) and its normals.
 pub fn thin_vertices(
-    positions: &[Vec3],
+    field: &MeshField,
     normals: &[Vec3],
     parts: &[u32],
     cell: f32,
-) -> (Vec<u32>, Vec<Vec3>) {
+) -> (MeshField, Vec<Vec3>) {
     let cell = cell.max(1e-9);
-    let mut voxels: HashMap<([i32; 3], u32), Vec<u32>> = HashMap::new();
+    let positions = &field.positions;
+    // Vertices are also binned by their normal's dominant axis and sign, so the two sides of a
+    // part thinner than a voxel stay apart (averaging their normals would cancel them).
+    let side = |n: Vec3| {
+        let a = n.abs();
+        let axis = if a.x >= a.y && a.x >= a.z {
+            0
+        } else if a.y >= a.z {
+            1
+        } else {
+            2
+        };
+        2 * axis + u32::from(n[axis as usize] < 0.0)
+    };
+    let mut voxels: HashMap<([i32; 3], u32, u32), Vec<u32>> = HashMap::new();
     let mut order = Vec::new();
     for (v, p) in positions.iter().enumerate() {
-        let key = ((*p / cell).floor().as_ivec3().to_array(), parts[v]);
+        let key = (
+            (*p / cell).floor().as_ivec3().to_array(),
+            parts[v],
+            side(normals[v]),
+        );
         voxels
             .entry(key)
             .or_insert_with(|| {
@@ -292,7 +313,27 @@ pub fn thin_vertices(
         chosen.push(best);
         smoothed.push(normal.normalize_or(normals[best as usize]));
     }
-    (chosen, smoothed)
+    let mut out = gather_vertices(field, &chosen, Vec::new());
+    let p = field.num_parts;
+    for (i, key) in order.iter().enumerate() {
+        let members = &voxels[key];
+        let n = members.len() as f32;
+        let mean = |values: &[f32], stride: usize, k: usize| {
+            members
+                .iter()
+                .map(|&v| values[v as usize * stride + k])
+                .sum::<f32>()
+                / n
+        };
+        for k in 0..SH_FLOATS {
+            out.sh[i * SH_FLOATS + k] = mean(&field.sh, SH_FLOATS, k);
+        }
+        out.opacity[i] = mean(&field.opacity, 1, 0);
+        for k in 0..p {
+            out.part_logits[i * p + k] = mean(&field.part_logits, p, k);
+        }
+    }
+    (out, smoothed)
 }
 
 /// One triangle mesh per part: each face goes to its [`face_part`], with only the vertices it
