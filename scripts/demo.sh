@@ -20,5 +20,4 @@ target/release/artmesh info "$out"
 target/release/artmesh eval "$out" "$out" --samples 2000 | grep -E '"(axis_ang|axis_pos|part_motion)"' | sort | uniq -c
 target/release/artmesh gpu
 target/release/artmesh reconstruct "$out" --out "$out.reconstruction" --preset fast > /dev/null
-grep -E '"(cross_part_faces|components|cd_mm|psnr_recovered)"' "$out.reconstruction/report.json" | sort | uniq -c
 echo "dataset in $out (object as URDF in $out/object); part meshes and report.json in $out.reconstruction"

@@ -682,6 +682,31 @@ mod cli {
         let mut files = reconstruction.as_ground_truth().to_files();
         files.insert("report.json".into(), to_json(&report)?.into_bytes());
         data::write_dir(&files, out).map_err(|e| e.to_string())?;
+        for s in &report.states {
+            eprintln!(
+                "reconstruct: {} state: PSNR {:.2} dB (optimised {:.2}, remeshed {:.2}), {} cross-part faces, {:.0} s",
+                s.state.name(),
+                s.psnr_recovered,
+                s.psnr_optimised,
+                s.psnr_remeshed,
+                s.cross_part_faces,
+                s.times.total_s
+            );
+            for p in &s.parts {
+                let gt = p
+                    .gt_components
+                    .map(|n| format!(" (ground truth {n})"))
+                    .unwrap_or_default();
+                let cd = p
+                    .chamfer
+                    .map(|c| format!(", Chamfer {:.1} mm / {:.3} peer", c.cd_mm, c.cd_peer))
+                    .unwrap_or_default();
+                eprintln!(
+                    "reconstruct:   part {}: {} faces, {} piece(s){gt}, {} boundary / {} non-manifold edges{cd}",
+                    p.part, p.faces, p.components, p.boundary_edges, p.non_manifold_edges
+                );
+            }
+        }
         eprintln!(
             "reconstruct: wrote {} files to {}",
             files.len(),
