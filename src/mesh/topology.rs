@@ -438,4 +438,46 @@ mod tests {
         assert_eq!(cross_part_faces(&faces, &parts), 1);
         assert_eq!(face_part(&[0, 3, 4], &parts), 1);
     }
+    #[test]
+    fn thinning_keeps_sides_and_parts_apart_and_averages_colour() {
+        // Four vertices in one voxel: two facing +z (part 0), one facing −z (part 0), one of part 1.
+        let positions = vec![
+            Vec3::new(0.1, 0.1, 0.1),
+            Vec3::new(0.2, 0.2, 0.1),
+            Vec3::new(0.15, 0.15, 0.12),
+            Vec3::new(0.3, 0.3, 0.3),
+        ];
+        let mut field = MeshField::new(positions.clone(), Vec::new(), 2, 0.0);
+        for (v, grey) in [0.2f32, 0.6, 0.9, 0.5].into_iter().enumerate() {
+            field.set_color(v, Vec3::splat(grey));
+        }
+        let normals = [Vec3::Z, Vec3::Z, -Vec3::Z, Vec3::Z];
+        let parts = [0, 0, 0, 1];
+        let (thin, smoothed) = thin_vertices(&field, &normals, &parts, 1.0);
+        assert_eq!(thin.num_vertices(), 3);
+        // The +z pair became one vertex at one of their positions, with their mean colour.
+        let pair = thin
+            .positions
+            .iter()
+            .position(|p| *p == positions[0] || *p == positions[1])
+            .unwrap();
+        assert_eq!(smoothed[pair], Vec3::Z);
+        let mean = 0.5 * (field.sh[0] + field.sh[SH_FLOATS]);
+        assert!((thin.sh[pair * SH_FLOATS] - mean).abs() < 1e-6);
+        assert!(thin.positions.contains(&positions[2]) && thin.positions.contains(&positions[3]));
+    }
+
+    #[test]
+    fn part_meshes_split_faces_by_label() {
+        let field = quad();
+        let parts = harden_parts(&field);
+        let meshes = part_meshes(&field.positions, &field.faces, &parts, 2);
+        // Face 0 = (0, 1, 2): labels 0, 0, 1 → part 0; face 1 = (0, 2, 3): 0, 1, 1 → part 1.
+        assert_eq!(meshes[0].triangles.len(), 1);
+        assert_eq!(meshes[1].triangles.len(), 1);
+        assert_eq!(
+            meshes[1].positions,
+            vec![field.positions[0], field.positions[2], field.positions[3]]
+        );
+    }
 }
