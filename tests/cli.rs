@@ -416,4 +416,21 @@ fn reconstruct_writes_part_meshes_and_a_report_and_refuses_bad_input() {
     assert!(!Path::new(&no_depth).exists());
     let bad = artmesh(&["reconstruct", &dir, "--out", &no_depth, "--preset", "huge"]);
     assert!(!bad.status.success() && text(&bad.stderr).contains("tiny"));
+
+    // The benchmark: one quick-suite object, seconds per phase and the dominant phase.
+    let bench = json(&artmesh(&[
+        "bench",
+        "reconstruct",
+        "--preset",
+        "tiny",
+        "--objects",
+        "pen",
+        "--size",
+        "32",
+        "--views",
+        "3",
+    ]));
+    assert_eq!(bench["objects"].as_array().unwrap().len(), 1);
+    assert!(bench["phases"]["seconds"]["optimise_s"].as_f64().unwrap() > 0.0);
+    assert!(bench["phases"]["dominant"].is_string());
 }

@@ -486,11 +486,7 @@ mod cli {
                 max_size,
                 max_views,
             } => {
-                use artmesh::fit::reconstruct::{Preset, ReconstructionConfig, RemeshMode};
-                let mut config = ReconstructionConfig::preset(Preset::parse(&preset)?);
-                if remesh == "global" {
-                    config.remesh = RemeshMode::Global;
-                }
+                let mut config = reconstruction_config(&preset, &remesh)?;
                 if let Some(n) = iterations {
                     config.fit.iterations = n;
                 }
@@ -588,11 +584,7 @@ mod cli {
                         remesh,
                     },
             } => {
-                use artmesh::fit::reconstruct::{Preset, ReconstructionConfig, RemeshMode};
-                let mut config = ReconstructionConfig::preset(Preset::parse(&preset)?);
-                if remesh == "global" {
-                    config.remesh = RemeshMode::Global;
-                }
+                let config = reconstruction_config(&preset, &remesh)?;
                 let ctx = context()?;
                 let report =
                     artmesh::bench::reconstruct(&ctx, &config, &objects, size, views, &mut |o| {
@@ -649,6 +641,19 @@ mod cli {
                 Ok(ExitCode::SUCCESS)
             }
         }
+    }
+
+    /// The named preset with the named remeshing mode (`part-aware` or `global`).
+    fn reconstruction_config(
+        preset: &str,
+        remesh: &str,
+    ) -> Result<artmesh::fit::reconstruct::ReconstructionConfig, String> {
+        use artmesh::fit::reconstruct::{Preset, ReconstructionConfig, RemeshMode};
+        let mut config = ReconstructionConfig::preset(Preset::parse(preset)?);
+        if remesh == "global" {
+            config.remesh = RemeshMode::Global;
+        }
+        Ok(config)
     }
 
     /// Loads `root`, reconstructs it with `config` (a progress bar on stderr), writes the part
