@@ -434,7 +434,6 @@ pub fn reconstruct(
     views: usize,
     log: &mut dyn FnMut(&ReconstructObject),
 ) -> Result<ReconstructBench, String> {
-    use crate::data::State;
     use crate::render::{RenderSpec, capture_dataset};
     use crate::synth::{generate, suite_plan};
     let mut objects = Vec::new();
@@ -466,10 +465,7 @@ pub fn reconstruct(
         let seconds = start.elapsed().as_secs_f64();
         let report = crate::eval::reconstruction_report(
             &reconstruction,
-            [
-                dataset.gt_meshes_for(State::Start),
-                dataset.gt_meshes_for(State::End),
-            ],
+            &dataset.gt_meshes,
             &crate::eval::ChamferOptions::default(),
         );
         for s in &report.states {

@@ -678,10 +678,7 @@ mod cli {
         bar.finish();
         let report = eval::reconstruction_report(
             &reconstruction,
-            [
-                dataset.gt_meshes_for(State::Start),
-                dataset.gt_meshes_for(State::End),
-            ],
+            &dataset.gt_meshes,
             &eval::ChamferOptions::default(),
         );
         let mut files = reconstruction.as_ground_truth().to_files();

@@ -129,10 +129,10 @@ pub fn state_quality(
 }
 
 /// The report of `reconstruction`; `gt` holds the ground-truth part meshes per state (start,
-/// end) when known.
+/// end) when known, as [`crate::data::Dataset::gt_meshes`] does.
 pub fn reconstruction_report(
     reconstruction: &Reconstruction,
-    gt: [Option<&GtMeshes>; 2],
+    gt: &[Option<GtMeshes>; 2],
     options: &ChamferOptions,
 ) -> ReconstructionReport {
     ReconstructionReport {
@@ -142,7 +142,7 @@ pub fn reconstruction_report(
         states: reconstruction
             .states
             .iter()
-            .map(|s| state_quality(s, gt[s.state.index()], options))
+            .map(|s| state_quality(s, gt[s.state.index()].as_ref(), options))
             .collect(),
     }
 }
@@ -177,10 +177,7 @@ pub async fn tiny_reconstruction(
         .map_err(|e| e.to_string())?;
     let report = reconstruction_report(
         &reconstruction,
-        [
-            dataset.gt_meshes_for(crate::data::State::Start),
-            dataset.gt_meshes_for(crate::data::State::End),
-        ],
+        &dataset.gt_meshes,
         &ChamferOptions {
             samples: 2_000,
             ..ChamferOptions::default()

@@ -4,12 +4,11 @@
 //! sample seeds one small triangle in its tangent plane, facing the camera that saw it, coloured
 //! from the image, half transparent, with part logits from the semantic map.
 
-use std::collections::HashMap;
-
 use glam::{Vec2, Vec3};
 use serde::Serialize;
 
 use crate::data::{Camera, Frame};
+use crate::mesh::topology::groups_in_order;
 use crate::raster::MeshField;
 use crate::rng::Rng;
 
@@ -124,37 +123,23 @@ fn frame_samples(frame: &Frame, num_parts: usize, out: &mut Vec<Sample>) {
 
 /// Averages the samples per (voxel, part).
 fn thin(samples: &[Sample], cell: f32) -> Vec<Sample> {
-    let mut voxels: HashMap<([i32; 3], u32), (Sample, u32)> = HashMap::new();
-    let mut order = Vec::new();
-    for s in samples {
-        let key = ((s.position / cell).floor().as_ivec3().to_array(), s.part);
-        let entry = voxels.entry(key).or_insert_with(|| {
-            order.push(key);
-            (
-                Sample {
-                    position: Vec3::ZERO,
-                    normal: Vec3::ZERO,
-                    color: Vec3::ZERO,
-                    part: s.part,
-                },
-                0,
-            )
-        });
-        entry.0.position += s.position;
-        entry.0.normal += s.normal;
-        entry.0.color += s.color;
-        entry.1 += 1;
-    }
-    order
+    let groups = groups_in_order(
+        samples
+            .iter()
+            .map(|s| ((s.position / cell).floor().as_ivec3().to_array(), s.part)),
+    );
+    groups
         .iter()
-        .map(|key| {
-            let (s, n) = voxels[key];
-            let n = n as f32;
+        .map(|group| {
+            let members = || group.iter().map(|&i| &samples[i as usize]);
+            let n = group.len() as f32;
+            let sum = |f: fn(&Sample) -> Vec3| members().map(f).sum::<Vec3>();
             Sample {
-                position: s.position / n,
-                normal: s.normal.normalize_or(Vec3::Z),
-                color: s.color / n,
-                part: s.part,
+                position: sum(|s| s.position) / n,
+                normal: sum(|s| s.normal).normalize_or(Vec3::Z),
+                color: sum(|s| s.color) / n,
+                // Every member shares the voxel's part (it is in the key).
+                part: samples[group[0] as usize].part,
             }
         })
         .collect()

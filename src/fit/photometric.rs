@@ -402,6 +402,24 @@ impl<'a> Trainer<'a> {
         self.field.download(ctx).await
     }
 
+    /// Starts a new fit of `field` against the same views: fresh Adam moments at `lr` and a new
+    /// view order from `seed`. The rasterizer, the loss and the uploaded targets are kept (the
+    /// reconstruction's recovery stage needs no second upload or pipeline build).
+    pub fn restart(
+        &mut self,
+        ctx: &GpuContext,
+        field: &MeshField,
+        lr: FieldLearningRates,
+        seed: u64,
+    ) -> GpuResult<()> {
+        let gpu_field = GpuField::upload(ctx, field)?;
+        self.optimizer = FieldAdam::new(ctx, &gpu_field, lr)?;
+        self.field = gpu_field;
+        self.rng = Rng::new(seed);
+        self.order.clear();
+        Ok(())
+    }
+
     /// Replaces the field after a topology edit, carrying Adam's moments along `map`
     /// (`map[new vertex] = old vertex` or [`crate::optim::FRESH`]).
     pub fn replace_field(

@@ -23,8 +23,8 @@ use super::views::downsample_frame;
 use crate::data::{Camera, Dataset, Frame, GroundTruth, GtMeshes, Split, State, TriMesh};
 use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
 use crate::mesh::topology::{
-    compact, cross_part_faces, drop_small_components, face_part, median_edge, retain_faces,
-    split_faces, thin_vertices, vertex_normals,
+    compact, cross_part_faces, drop_small_components, face_part, longest_edge, median_edge,
+    retain_faces, split_faces, thin_vertices, vertex_normals,
 };
 use crate::mesh::{
     RemeshOptions, harden_parts, part_aware_remesh, part_meshes, restricted_delaunay,
@@ -324,7 +324,7 @@ impl PhaseTimes {
     /// Adds `other`'s seconds to these.
     pub fn accumulate(&mut self, other: &PhaseTimes) {
         for (mine, theirs) in self.phases_mut().into_iter().zip(other.phases()) {
-            *mine.1 += theirs.1;
+            *mine += theirs.1;
         }
         self.total_s += other.total_s;
     }
@@ -341,14 +341,15 @@ impl PhaseTimes {
         ]
     }
 
-    fn phases_mut(&mut self) -> [(&'static str, &mut f64); 6] {
+    /// The same fields as [`PhaseTimes::phases`], in the same order, to add to.
+    fn phases_mut(&mut self) -> [&mut f64; 6] {
         [
-            ("initialise", &mut self.initialise_s),
-            ("optimise", &mut self.optimise_s),
-            ("densify", &mut self.densify_s),
-            ("remesh", &mut self.remesh_s),
-            ("recover", &mut self.recover_s),
-            ("measure", &mut self.measure_s),
+            &mut self.initialise_s,
+            &mut self.optimise_s,
+            &mut self.densify_s,
+            &mut self.remesh_s,
+            &mut self.recover_s,
+            &mut self.measure_s,
         ]
     }
 
@@ -502,11 +503,6 @@ fn pixels_per_metre(field: &MeshField, cameras: &[Camera]) -> f32 {
     camera.intrinsics.fx / d[d.len() / 2].max(1e-6)
 }
 
-fn longest_edge(field: &MeshField, f: &[u32; 3]) -> f32 {
-    let [a, b, c] = f.map(|v| field.positions[v as usize]);
-    a.distance(b).max(b.distance(c)).max(c.distance(a))
-}
-
 fn sigmoid(x: f32) -> f32 {
     1.0 / (1.0 + (-x).exp())
 }
@@ -524,7 +520,7 @@ fn densify_and_prune(
     let mut candidates = Vec::new();
     for (f, face) in field.faces.iter().enumerate() {
         let (weight, _) = stats.get(f).copied().unwrap_or((0.0, 0));
-        let edge_px = longest_edge(field, face) * px_per_m;
+        let edge_px = longest_edge(&field.positions, face) * px_per_m;
         let opacity = face
             .iter()
             .map(|&v| sigmoid(field.opacity[v as usize]))
@@ -751,7 +747,6 @@ pub async fn reconstruct_state(
     let final_settings = fit.settings_at(fit.iterations);
     let psnr_optimised = trainer.mean_psnr(ctx, &final_settings).await?;
     let optimised = trainer.download(ctx).await?;
-    drop(trainer);
     times.measure_s += lap();
 
     // Hardening and part-aware remeshing.
@@ -769,10 +764,8 @@ pub async fn reconstruct_state(
 
     // Recovery with fixed topology.
     let recovery = config.recovery();
-    let mut trainer = Trainer::new(
+    trainer.restart(
         ctx,
-        &cameras,
-        frames,
         &remeshed,
         recovery.rates(recovery.position_lr.0),
         fit.seed ^ 1,

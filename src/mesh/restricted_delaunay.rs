@@ -12,6 +12,8 @@ use std::collections::HashMap;
 use glam::{DVec2, Vec3};
 use spade::{DelaunayTriangulation, Point2, Triangulation};
 
+use super::topology::{longest_edge, median_edge};
+
 /// Knobs of [`restricted_delaunay`].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct RemeshOptions {
@@ -224,7 +226,7 @@ pub fn restricted_delaunay(
             };
             let [a, b, c] = [ids[0], ids[1], ids[2]];
             let (pa, pb, pc) = (points[a as usize], points[b as usize], points[c as usize]);
-            if pa.distance(pb).max(pb.distance(pc)).max(pc.distance(pa)) > max_edge {
+            if longest_edge(points, &[a, b, c]) > max_edge {
                 continue;
             }
             // Orient by the vertex's normal.
@@ -271,18 +273,14 @@ fn accept_votes(votes: HashMap<[u32; 3], (u32, [u32; 3])>, points: &[Vec3]) -> V
     // Where neighbouring umbrellas disagreed a hole is left; a one-vote triangle that closes it
     // (two or three of its edges already on the hole's rim, none overused, no edge longer than
     // twice the accepted faces' median) fills it. Two rounds: a filled notch can expose the next.
-    let longest = |f: &[u32; 3]| {
-        let [a, b, c] = f.map(|v| points[v as usize]);
-        a.distance(b).max(b.distance(c)).max(c.distance(a))
-    };
-    let limit = 2.0 * crate::mesh::topology::median_edge(points, &faces);
+    let limit = 2.0 * median_edge(points, &faces);
     for _ in 0..2 {
         single.retain(|f| {
             let edges = [edge(f[0], f[1]), edge(f[1], f[2]), edge(f[2], f[0])];
             let uses = edges.map(|e| edge_use.get(&e).copied().unwrap_or(0));
             let fills = uses.iter().all(|&u| u < 2)
                 && uses.iter().filter(|&&u| u == 1).count() >= 2
-                && longest(f) <= limit;
+                && longest_edge(points, f) <= limit;
             if fills {
                 for e in edges {
                     *edge_use.entry(e).or_default() += 1;
@@ -329,12 +327,8 @@ mod tests {
         face_components(faces).1
     }
 
-    fn longest_edge(p: &[Vec3], faces: &[[u32; 3]]) -> f32 {
-        faces
-            .iter()
-            .flat_map(|f| (0..3).map(move |i| (f[i], f[(i + 1) % 3])))
-            .map(|(a, b)| p[a as usize].distance(p[b as usize]))
-            .fold(0.0, f32::max)
+    fn longest(p: &[Vec3], faces: &[[u32; 3]]) -> f32 {
+        faces.iter().map(|f| longest_edge(p, f)).fold(0.0, f32::max)
     }
 
     fn grid(
@@ -376,7 +370,7 @@ mod tests {
             "{} faces",
             faces.len()
         );
-        assert!(longest_edge(&p, &faces) < 3.0 * 0.05);
+        assert!(longest(&p, &faces) < 3.0 * 0.05);
     }
 
     #[test]
@@ -442,7 +436,7 @@ mod tests {
         let faces = restricted_delaunay(&p, None, &RemeshOptions::default());
         assert_manifold(&faces);
         assert_eq!(components(p.len(), &faces), 1);
-        assert!(longest_edge(&p, &faces) < 3.0 * h);
+        assert!(longest(&p, &faces) < 3.0 * h);
         for f in &faces {
             let c = (p[f[0] as usize] + p[f[1] as usize] + p[f[2] as usize]) / 3.0;
             assert!(

@@ -237,6 +237,29 @@ pub fn drop_small_components(faces: &[[u32; 3]], min_fraction: f32) -> Vec<bool>
         .collect()
 }
 
+/// Indices grouped by equal key, groups in order of their key's first appearance (so results do
+/// not depend on hash order). The voxel grids of the seeding and the thinning use it.
+pub fn groups_in_order<K: std::hash::Hash + Eq>(
+    keys: impl IntoIterator<Item = K>,
+) -> Vec<Vec<u32>> {
+    let mut slot: HashMap<K, usize> = HashMap::new();
+    let mut groups: Vec<Vec<u32>> = Vec::new();
+    for (i, key) in keys.into_iter().enumerate() {
+        let g = *slot.entry(key).or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[g].push(i as u32);
+    }
+    groups
+}
+
+/// Length of a face's longest edge.
+pub fn longest_edge(positions: &[Vec3], face: &[u32; 3]) -> f32 {
+    let [a, b, c] = face.map(|v| positions[v as usize]);
+    a.distance(b).max(b.distance(c)).max(c.distance(a))
+}
+
 /// Median edge length of `faces`.
 pub fn median_edge(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
     let mut lengths: Vec<f32> = faces
@@ -278,26 +301,16 @@ pub fn thin_vertices(
         };
         2 * axis + u32::from(n[axis as usize] < 0.0)
     };
-    let mut voxels: HashMap<([i32; 3], u32, u32), Vec<u32>> = HashMap::new();
-    let mut order = Vec::new();
-    for (v, p) in positions.iter().enumerate() {
-        let key = (
+    let groups = groups_in_order(positions.iter().enumerate().map(|(v, p)| {
+        (
             (*p / cell).floor().as_ivec3().to_array(),
             parts[v],
             side(normals[v]),
-        );
-        voxels
-            .entry(key)
-            .or_insert_with(|| {
-                order.push(key);
-                Vec::new()
-            })
-            .push(v as u32);
-    }
-    let mut chosen = Vec::with_capacity(order.len());
-    let mut smoothed = Vec::with_capacity(order.len());
-    for key in &order {
-        let members = &voxels[key];
+        )
+    }));
+    let mut chosen = Vec::with_capacity(groups.len());
+    let mut smoothed = Vec::with_capacity(groups.len());
+    for members in &groups {
         let mean =
             members.iter().map(|&v| positions[v as usize]).sum::<Vec3>() / members.len() as f32;
         let best = members
@@ -315,8 +328,7 @@ pub fn thin_vertices(
     }
     let mut out = gather_vertices(field, &chosen, Vec::new());
     let p = field.num_parts;
-    for (i, key) in order.iter().enumerate() {
-        let members = &voxels[key];
+    for (i, members) in groups.iter().enumerate() {
         let n = members.len() as f32;
         let mean = |values: &[f32], stride: usize, k: usize| {
             members
