@@ -5,6 +5,7 @@
 //! I/O-free at its core so the same code runs natively (CLI, tests, lavapipe in CI) and in the browser (WebGPU);
 //! file-system access lives only in the CLI and in native-only helpers.
 
+pub mod articulation;
 pub mod data;
 pub mod eval;
 pub mod fit;
