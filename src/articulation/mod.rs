@@ -2,6 +2,8 @@
 //! inverse, the per-part gradient sums both consistency terms reduce to, and the vertex-wise
 //! motion consistency on the CPU.
 
+pub mod motion;
 pub mod sums;
 
+pub use motion::{MotionAdam, MotionGradient, MotionMask, MotionRates, PartMotion};
 pub use sums::PartSums;

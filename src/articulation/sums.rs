@@ -8,7 +8,7 @@ use glam::{DMat3, DVec3};
 
 /// Σ gᵢ and Σ gᵢ xᵢᵀ over one part's vertices, where gᵢ = ∂L/∂x̂ᵢ at the moved position and xᵢ
 /// the vertex's position before the motion.
-#[derive(Debug, Clone, Copy, PartialEq, Default)]
+#[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PartSums {
     /// Σ gᵢ.
     pub g: DVec3,
@@ -16,6 +16,17 @@ pub struct PartSums {
     pub gx: DMat3,
     /// Vertices that contributed.
     pub count: u32,
+}
+
+// Not derived: glam's matrices default to the identity, the sums must start at zero.
+impl Default for PartSums {
+    fn default() -> Self {
+        Self {
+            g: DVec3::ZERO,
+            gx: DMat3::ZERO,
+            count: 0,
+        }
+    }
 }
 
 impl PartSums {
