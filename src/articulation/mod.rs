@@ -2,6 +2,7 @@
 //! inverse, the per-part gradient sums both consistency terms reduce to, and the vertex-wise
 //! motion consistency on the CPU.
 
+pub mod init;
 pub mod kernels;
 pub mod motion;
 pub mod sums;

@@ -169,21 +169,32 @@ impl KdTree {
 
     /// Squared distance from `q` to its nearest point (infinite for an empty tree).
     pub fn nearest_distance_squared(&self, q: Vec3) -> f64 {
-        let mut best = f64::INFINITY;
-        self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
-        best
+        self.nearest(q).map_or(f64::INFINITY, |(_, d2)| d2)
     }
 
-    fn search(&self, q: glam::DVec3, lo: usize, hi: usize, best: &mut f64) {
+    /// The point nearest to `q` and its squared distance; `None` for an empty tree.
+    pub fn nearest(&self, q: Vec3) -> Option<(Vec3, f64)> {
+        let mut best = (f64::INFINITY, usize::MAX);
+        self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
+        self.points.get(best.1).map(|&p| (p, best.0))
+    }
+
+    fn search(&self, q: glam::DVec3, lo: usize, hi: usize, best: &mut (f64, usize)) {
+        let mut consider = |i: usize, best: &mut (f64, usize)| {
+            let d2 = q.distance_squared(self.points[i].as_dvec3());
+            if d2 < best.0 {
+                *best = (d2, i);
+            }
+        };
         if hi - lo <= LEAF_SIZE {
-            for p in &self.points[lo..hi] {
-                *best = best.min(q.distance_squared(p.as_dvec3()));
+            for i in lo..hi {
+                consider(i, best);
             }
             return;
         }
         let m = lo + (hi - lo) / 2;
+        consider(m, best);
         let p = self.points[m].as_dvec3();
-        *best = best.min(q.distance_squared(p));
         let axis = usize::from(self.axis[m]);
         let diff = q[axis] - p[axis];
         let (near, far) = if diff < 0.0 {
@@ -193,7 +204,7 @@ impl KdTree {
         };
         self.search(q, near.0, near.1, best);
         // The far side can only hold a closer point if the splitting plane is closer than the best so far.
-        if diff * diff < *best {
+        if diff * diff < best.0 {
             self.search(q, far.0, far.1, best);
         }
     }
