@@ -494,3 +494,227 @@ pub fn reconstruct(
         objects,
     })
 }
+
+/// One object of `artmesh bench fit`.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitObject {
+    pub id: String,
+    pub category: &'static str,
+    pub parts: usize,
+    /// Wall time of the whole fit, and of its two phases.
+    pub seconds: f64,
+    pub reconstruct_s: f64,
+    pub articulate_s: f64,
+    pub metrics: crate::eval::ObjectMetrics,
+    pub joints: Vec<crate::fit::object::JointRecord>,
+    pub warnings: Vec<String>,
+}
+
+/// One variant of the ablation study (paper Table 4), over the same objects.
+#[derive(Debug, Clone, Serialize)]
+pub struct AblationRun {
+    pub name: &'static str,
+    pub objects: Vec<crate::eval::ObjectMetrics>,
+}
+
+/// `artmesh bench fit` output: per-object metrics and times, the paper-style tables and, when
+/// asked, the ablation table.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitBench {
+    pub bench: &'static str,
+    pub adapter: AdapterReport,
+    pub suite: &'static str,
+    pub config: crate::fit::object::FitConfig,
+    pub capture: CaptureSettings,
+    pub objects: Vec<FitObject>,
+    pub by_part_count: crate::eval::BenchmarkTable,
+    pub by_category: crate::eval::BenchmarkTable,
+    /// Full model, w/o V-Color, w/o V-Opacity, w/o BackwardPass, w/o PartAware (All columns).
+    pub ablation: Option<crate::eval::BenchmarkTable>,
+    pub ablation_runs: Vec<AblationRun>,
+    pub total_s: f64,
+}
+
+impl FitBench {
+    /// The tables as Markdown (by part count, by category, ablations).
+    pub fn to_markdown(&self) -> String {
+        let mut out = format!(
+            "### By part count\n\n{}\n### By category\n\n{}",
+            self.by_part_count.to_markdown(),
+            self.by_category.to_markdown()
+        );
+        if let Some(t) = &self.ablation {
+            out.push_str(&format!("\n### Ablations\n\n{}", t.to_markdown()));
+        }
+        out
+    }
+}
+
+/// The ablation variants of the articulation phase, by table label.
+const ARTICULATION_ABLATIONS: [(&str, &str); 3] = [
+    ("w/o V-Color", "no-vertex-color"),
+    ("w/o V-Opacity", "no-vertex-opacity"),
+    ("w/o BackwardPass", "no-backward"),
+];
+
+/// Fits the suite's objects (all, or those whose id contains one of `only`), each captured in
+/// memory at `size`² with `views` training views per state, and scores them. With `ablations`,
+/// each object's reconstruction is also re-articulated without each consistency component, and
+/// reconstructed and articulated once more with global remeshing.
+#[allow(clippy::too_many_arguments)]
+pub fn fit(
+    ctx: &GpuContext,
+    config: &crate::fit::object::FitConfig,
+    quick: bool,
+    only: &[String],
+    size: u32,
+    views: usize,
+    ablations: bool,
+    log: &mut dyn FnMut(&FitObject),
+) -> Result<FitBench, String> {
+    use crate::eval::{BenchmarkTable, ColumnSummary, EvalOptions};
+    use crate::fit::articulate::{Ablation, articulate};
+    use crate::fit::object::ObjectFit;
+    use crate::fit::reconstruct::{RemeshMode, reconstruct};
+    use crate::render::{RenderSpec, capture_dataset};
+    use crate::synth::{generate, suite_plan};
+    let started = Instant::now();
+    let options = EvalOptions::default();
+    let mut objects = Vec::new();
+    let mut runs: Vec<AblationRun> = std::iter::once("Full model")
+        .chain(ARTICULATION_ABLATIONS.iter().map(|a| a.0))
+        .chain(["w/o PartAware"])
+        .map(|name| AblationRun {
+            name,
+            objects: Vec::new(),
+        })
+        .collect();
+    for entry in suite_plan(quick) {
+        let id = entry.id();
+        if !only.is_empty() && !only.iter().any(|o| id.contains(o.as_str())) {
+            continue;
+        }
+        let named = |e: String| format!("{id}: {e}");
+        let object = generate(&entry.params()).map_err(named)?;
+        let spec = RenderSpec {
+            width: size,
+            height: size,
+            train_views: views,
+            test_views: 0,
+            seed: entry.seed,
+            ..RenderSpec::default()
+        };
+        let dataset = pollster::block_on(capture_dataset(ctx, &object, &spec))
+            .map_err(|e| named(e.to_string()))?;
+        let score = |fit: &ObjectFit| -> Result<crate::eval::ObjectMetrics, String> {
+            fit.evaluate(&dataset, &id, entry.category, &options)
+                .ok_or_else(|| named("the captured object has no ground-truth joints".into()))?
+                .map_err(|e| named(e.to_string()))
+        };
+        let start = Instant::now();
+        let reconstruction = pollster::block_on(reconstruct(
+            ctx,
+            &dataset,
+            &config.reconstruction,
+            &mut |_| {},
+        ))
+        .map_err(|e| named(e.to_string()))?;
+        let reconstruct_s = start.elapsed().as_secs_f64();
+        let articulation = pollster::block_on(articulate(
+            ctx,
+            &dataset,
+            &reconstruction,
+            &config.articulation,
+            &mut |_| {},
+        ))
+        .map_err(|e| named(e.to_string()))?;
+        let seconds = start.elapsed().as_secs_f64();
+        let mut fit = ObjectFit {
+            reconstruction,
+            articulation,
+        };
+        let metrics = score(&fit)?;
+        let done = FitObject {
+            id: id.clone(),
+            category: entry.category,
+            parts: dataset.num_parts,
+            seconds,
+            reconstruct_s,
+            articulate_s: seconds - reconstruct_s,
+            metrics: metrics.clone(),
+            joints: fit.joint_records(),
+            warnings: fit.articulation.warnings.clone(),
+        };
+        log(&done);
+        objects.push(done);
+        if ablations {
+            runs[0].objects.push(metrics);
+            for (run, (_, name)) in runs[1..].iter_mut().zip(ARTICULATION_ABLATIONS) {
+                let articulation = crate::fit::articulate::ArticulationConfig {
+                    ablation: Ablation::parse(name)?,
+                    ..config.articulation
+                };
+                fit.articulation = pollster::block_on(articulate(
+                    ctx,
+                    &dataset,
+                    &fit.reconstruction,
+                    &articulation,
+                    &mut |_| {},
+                ))
+                .map_err(|e| named(e.to_string()))?;
+                run.objects.push(score(&fit)?);
+            }
+            let global = crate::fit::reconstruct::ReconstructionConfig {
+                remesh: RemeshMode::Global,
+                ..config.reconstruction
+            };
+            fit.reconstruction =
+                pollster::block_on(reconstruct(ctx, &dataset, &global, &mut |_| {}))
+                    .map_err(|e| named(e.to_string()))?;
+            fit.articulation = pollster::block_on(articulate(
+                ctx,
+                &dataset,
+                &fit.reconstruction,
+                &config.articulation,
+                &mut |_| {},
+            ))
+            .map_err(|e| named(e.to_string()))?;
+            runs[4].objects.push(score(&fit)?);
+            eprintln!(
+                "bench fit: {id} ablations (Axis Ang): {}",
+                runs.iter()
+                    .map(|r| format!(
+                        "{} {:.2}",
+                        r.name,
+                        r.objects.last().and_then(|m| m.axis_ang).unwrap_or(f64::NAN)
+                    ))
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            );
+        }
+    }
+    let metrics: Vec<crate::eval::ObjectMetrics> =
+        objects.iter().map(|o| o.metrics.clone()).collect();
+    let ablation = ablations.then(|| BenchmarkTable {
+        columns: runs
+            .iter()
+            .map(|r| ColumnSummary::new(r.name, &r.objects.iter().collect::<Vec<_>>()))
+            .collect(),
+    });
+    Ok(FitBench {
+        bench: "fit",
+        adapter: ctx.adapter.clone(),
+        suite: if quick { "quick" } else { "full" },
+        config: *config,
+        capture: CaptureSettings {
+            size,
+            train_views: views,
+        },
+        by_part_count: BenchmarkTable::by_part_count(&metrics),
+        by_category: BenchmarkTable::by_category(&metrics),
+        ablation,
+        ablation_runs: if ablations { runs } else { Vec::new() },
+        objects,
+        total_s: started.elapsed().as_secs_f64(),
+    })
+}

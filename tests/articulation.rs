@@ -8,3 +8,129 @@ fn motion_kernels_match_the_cpu() {
     let ctx = common::context();
     pollster::block_on(artmesh::articulation::kernels::check_against_cpu(&ctx)).unwrap();
 }
+
+use artmesh::data::{JointKind, Split, State};
+use artmesh::eval::EvalOptions;
+use artmesh::fit::object::tiny_fit;
+use artmesh::synth::Category;
+
+fn no_edit(_: &mut artmesh::data::Dataset) {}
+fn no_spec_edit(_: &mut artmesh::render::RenderSpec) {}
+
+#[test]
+fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
+    let ctx = common::context();
+    for (category, seed, want) in [
+        (Category::Laptop, 1005, JointKind::Revolute),
+        (Category::Pen, 1007, JointKind::Prismatic),
+    ] {
+        let (dataset, fit) = pollster::block_on(tiny_fit(
+            &ctx,
+            category,
+            1,
+            seed,
+            &no_spec_edit,
+            &no_edit,
+        ))
+        .unwrap();
+        let joint = &fit.articulation.joints[0];
+        println!("{category:?}: {joint:#?}");
+        assert_eq!(joint.kind, want, "{:?}", joint.bake_off);
+        let (rot, trans) = (
+            joint.bake_off.revolute_loss.unwrap(),
+            joint.bake_off.prismatic_loss.unwrap(),
+        );
+        match want {
+            JointKind::Revolute => assert!(rot <= trans),
+            JointKind::Prismatic => assert!(trans < rot),
+        }
+        let metrics = fit
+            .evaluate(&dataset, "tiny", category.name(), &EvalOptions::default())
+            .unwrap()
+            .unwrap();
+        println!("{category:?}: {}", serde_json::to_string(&metrics).unwrap());
+        assert_eq!(metrics.type_accuracy, Some(1.0));
+        // 32² views: a pixel is about 1 cm at the object; the axis is still within a few degrees.
+        assert!(metrics.axis_ang.unwrap() < 10.0, "{metrics:?}");
+    }
+}
+
+#[test]
+fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
+    let ctx = common::context();
+    // A part that does not move: both states drawn at the same joint value.
+    let (_, fit) = pollster::block_on(tiny_fit(
+        &ctx,
+        Category::Laptop,
+        1,
+        1005,
+        &|spec| {
+            spec.start_range = (0.5, 0.5);
+            spec.end_range = (0.5, 0.5);
+        },
+        &no_edit,
+    ))
+    .unwrap();
+    println!("still: {:?}", fit.articulation.warnings);
+    assert!(
+        fit.articulation.warnings.iter().any(|w| w.contains("barely moves")),
+        "{:?} {:?}",
+        fit.articulation.warnings,
+        fit.articulation.joints[0].joint
+    );
+
+    // A part invisible in the end state: its pixels there are labelled as the base.
+    let (_, fit) = pollster::block_on(tiny_fit(
+        &ctx,
+        Category::Laptop,
+        1,
+        1005,
+        &no_spec_edit,
+        &|d| {
+            for v in d.views.iter_mut().filter(|v| v.state == State::End) {
+                for f in &mut v.frames {
+                    for id in &mut f.parts.as_mut().unwrap().ids {
+                        if *id == 1 {
+                            *id = 0;
+                        }
+                    }
+                }
+            }
+        },
+    ))
+    .unwrap();
+    println!("invisible: {:?}", fit.articulation.warnings);
+    assert!(
+        fit.articulation
+            .warnings
+            .iter()
+            .any(|w| w.contains("part 1") && w.contains("end state")),
+        "{:?}",
+        fit.articulation.warnings
+    );
+    assert_eq!(fit.articulation.joints.len(), 1);
+
+    // No depth in any view of one state: a clear error, not a panic.
+    let err = pollster::block_on(tiny_fit(
+        &ctx,
+        Category::Laptop,
+        1,
+        1005,
+        &no_spec_edit,
+        &|d| {
+            for v in d
+                .views
+                .iter_mut()
+                .filter(|v| v.state == State::End && v.split == Split::Train)
+            {
+                for f in &mut v.frames {
+                    f.depth = None;
+                }
+            }
+        },
+    ))
+    .unwrap_err();
+    println!("no depth: {err}");
+    assert!(err.contains("depth") && err.contains("end"), "{err}");
+}
+

@@ -6,6 +6,8 @@ pub mod init;
 pub mod kernels;
 pub mod motion;
 pub mod sums;
+pub mod vertex_motion;
 
 pub use motion::{MotionAdam, MotionGradient, MotionMask, MotionRates, PartMotion};
 pub use sums::PartSums;
+pub use vertex_motion::{StateSurface, VertexMotionLoss, VertexMotionWeights, vertex_motion_loss};

@@ -178,6 +178,50 @@ mod cli {
             #[arg(long)]
             max_views: Option<usize>,
         },
+        /// The main job: reconstruct both states and fit every joint (revolute or prismatic: axis,
+        /// pivot, motion). Writes OUT/joints.json (type, axis origin and direction, motion, limits per
+        /// movable part), OUT/gt/ (trans.json and one PLY per part and state: the layout `eval` reads)
+        /// and OUT/report.json (times, bake-off losses, warnings, mesh quality, and the paper's metrics
+        /// when the dataset has ground truth); prints the joints and metrics.
+        Fit {
+            /// Dataset folder (ArtGS / MPArt-90 / PARIS layout, with depth and semantic maps).
+            dataset: PathBuf,
+            /// New folder to write.
+            #[arg(long)]
+            out: PathBuf,
+            /// Budget: tiny (tests, seconds), fast (CPU demo, minutes), paper (the paper's 20k + 20k iterations).
+            #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
+            preset: String,
+            /// Articulation ablation: full, no-vertex-color, no-vertex-opacity or no-backward.
+            #[arg(long, default_value = "full", value_parser = ["full", "no-vertex-color", "no-vertex-opacity", "no-backward"])]
+            ablation: String,
+            /// part-aware (the paper) or global remeshing (ablation).
+            #[arg(long, default_value = "part-aware", value_parser = ["part-aware", "global"])]
+            remesh: String,
+            /// Override the preset's articulation steps.
+            #[arg(long)]
+            articulation_iterations: Option<u32>,
+        },
+        /// Zero-set-up demo: generate the built-in object (a procedural cabinet with a drawer and a
+        /// door), capture it at 64x64 with 12 views per state, fit it, score it against its ground
+        /// truth and write everything (dataset, fit, metrics) to a new folder.
+        Demo {
+            /// New folder to write [default: a fresh ./artmesh-demo, -2, -3, ...].
+            #[arg(long)]
+            out: Option<PathBuf>,
+            /// Budget (see `fit`).
+            #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
+            preset: String,
+            /// Category of the generated object (see `synth`).
+            #[arg(long, default_value = "storage")]
+            category: String,
+            /// Movable parts.
+            #[arg(long, default_value_t = 2, value_parser = clap::value_parser!(u8).range(1..=15))]
+            parts: u8,
+            /// Seed of the object, its states and cameras.
+            #[arg(long, default_value_t = 4)]
+            seed: u64,
+        },
         /// Capture a URDF object (with its meshes) as a two-state dataset with ground truth.
         Render {
             /// The URDF; relative mesh paths resolve against its folder, package:// paths against the
@@ -306,6 +350,37 @@ mod cli {
             /// part-aware or global remeshing.
             #[arg(long, default_value = "part-aware", value_parser = ["part-aware", "global"])]
             remesh: String,
+        },
+        /// The whole fit (reconstruction + articulation) over a suite, captured in memory, scored
+        /// against ground truth: per-object metrics and wall time, the paper-style tables by part
+        /// count and by category (JSON on stdout; Markdown with --markdown), and with --ablations the
+        /// paper's Table 4.
+        Fit {
+            /// quick (16 objects, one per category) or full (100 objects).
+            #[arg(long, default_value = "quick", value_parser = ["quick", "full"])]
+            suite: String,
+            /// Preset: tiny, fast or paper.
+            #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
+            preset: String,
+            /// Only objects whose id contains one of these (e.g. laptop,oven).
+            #[arg(long, value_delimiter = ',')]
+            objects: Vec<String>,
+            /// Square capture size.
+            #[arg(long, default_value_t = 64)]
+            size: u32,
+            /// Training views per state.
+            #[arg(long, default_value_t = 6)]
+            views: usize,
+            /// Override the preset's articulation steps.
+            #[arg(long)]
+            articulation_iterations: Option<u32>,
+            /// Also run the four ablations (w/o vertex colour, w/o vertex opacity, w/o backward pass,
+            /// w/o part-aware remeshing) on every object.
+            #[arg(long)]
+            ablations: bool,
+            /// Also write the tables as Markdown to this new file.
+            #[arg(long)]
+            markdown: Option<PathBuf>,
         },
         /// Radix-sort throughput (keys/s) on the current adapter.
         Sort {
@@ -477,6 +552,89 @@ mod cli {
                 out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
+            Command::Fit {
+                dataset: root,
+                out,
+                preset,
+                ablation,
+                remesh,
+                articulation_iterations,
+            } => {
+                let mut config = fit_config(&preset)?;
+                config.reconstruction = reconstruction_config(&preset, &remesh)?;
+                config.articulation.ablation =
+                    artmesh::fit::articulate::Ablation::parse(&ablation)?;
+                if let Some(n) = articulation_iterations {
+                    config.articulation.iterations = n;
+                }
+                capture::fresh_folder(&out)?;
+                let files = data::read_dir(&root).map_err(|e| e.to_string())?;
+                let dataset = Dataset::from_files(&files).map_err(|e| {
+                    format!("{}: {} problem(s):\n{e}", root.display(), e.0.len())
+                })?;
+                let id = root
+                    .file_name()
+                    .map_or("object".into(), |n| n.to_string_lossy().into_owned());
+                let report = fit_and_write(&dataset, &config, &out, &id, "unknown")?;
+                out!("{}", to_json(&report)?);
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Demo {
+                out,
+                preset,
+                category,
+                parts,
+                seed,
+            } => {
+                let out = match out {
+                    Some(out) => {
+                        capture::fresh_folder(&out)?;
+                        out
+                    }
+                    None => (1..)
+                        .map(|i| {
+                            PathBuf::from(if i == 1 {
+                                "artmesh-demo".to_string()
+                            } else {
+                                format!("artmesh-demo-{i}")
+                            })
+                        })
+                        .find(|p| !p.exists())
+                        .expect("some folder name is free"),
+                };
+                let category = artmesh::synth::Category::parse(&category)?;
+                let object = artmesh::synth::generate(&artmesh::synth::SynthParams {
+                    category,
+                    movable_parts: Some(usize::from(parts)),
+                    seed,
+                })?;
+                let config = fit_config(&preset)?;
+                let size = config.reconstruction.max_size.clamp(32, 512);
+                let views = config.reconstruction.max_views.clamp(4, 100);
+                let spec = RenderSpec {
+                    width: size,
+                    height: size,
+                    train_views: views,
+                    test_views: 0,
+                    seed,
+                    ..RenderSpec::default()
+                };
+                let ctx = context()?;
+                eprintln!(
+                    "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state",
+                    object.name, parts
+                );
+                let dataset =
+                    pollster::block_on(artmesh::render::capture_dataset(&ctx, &object, &spec))
+                        .map_err(|e| format!("{}: {e}", object.name))?;
+                let files = dataset.to_files().map_err(|e| e.to_string())?;
+                data::write_dir(&files, &out.join("dataset")).map_err(|e| e.to_string())?;
+                let report =
+                    fit_and_write(&dataset, &config, &out.join("fit"), &object.name, category.name())?;
+                out!("{}", to_json(&report)?);
+                eprintln!("demo: dataset in {0}/dataset, fit in {0}/fit", out.display());
+                Ok(ExitCode::SUCCESS)
+            }
             Command::Reconstruct {
                 dataset,
                 out,
@@ -541,6 +699,63 @@ mod cli {
             } => {
                 let ctx = context()?;
                 capture::suite(&ctx, &out, quick, &capture)?;
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Bench {
+                which:
+                    Bench::Fit {
+                        suite,
+                        preset,
+                        objects,
+                        size,
+                        views,
+                        articulation_iterations,
+                        ablations,
+                        markdown,
+                    },
+            } => {
+                let mut config = fit_config(&preset)?;
+                if let Some(n) = articulation_iterations {
+                    config.articulation.iterations = n;
+                }
+                if let Some(path) = &markdown {
+                    capture::fresh_file(path)?;
+                }
+                let ctx = context()?;
+                let report = artmesh::bench::fit(
+                    &ctx,
+                    &config,
+                    suite == "quick",
+                    &objects,
+                    size,
+                    views,
+                    ablations,
+                    &mut |o| {
+                        let m = &o.metrics;
+                        let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+                        eprintln!(
+                            "bench fit: {} ({} parts) {:.0} s  axis ang {}  axis pos {}  motion {}  CD-s {}  CD-m {}  types {}",
+                            o.id,
+                            o.parts,
+                            o.seconds,
+                            f(m.axis_ang),
+                            f(m.axis_pos),
+                            f(m.part_motion),
+                            f(m.cd_s.map(|c| c.cd_peer)),
+                            f(m.cd_m.map(|c| c.cd_peer)),
+                            f(m.type_accuracy)
+                        );
+                        for w in &o.warnings {
+                            eprintln!("bench fit:   warning: {w}");
+                        }
+                    },
+                )?;
+                let md = report.to_markdown();
+                eprintln!("{md}");
+                if let Some(path) = &markdown {
+                    std::fs::write(path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+                }
+                out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
             Command::Bench {
@@ -641,6 +856,95 @@ mod cli {
                 Ok(ExitCode::SUCCESS)
             }
         }
+    }
+
+    /// Fits `dataset` with a progress bar on stderr, writes joints.json, gt/ and report.json
+    /// under `out` (a fresh folder), prints the joints and metrics, and returns the report.
+    fn fit_and_write(
+        dataset: &Dataset,
+        config: &artmesh::fit::object::FitConfig,
+        out: &Path,
+        id: &str,
+        category: &str,
+    ) -> Result<serde_json::Value, String> {
+        let ctx = context()?;
+        let start = std::time::Instant::now();
+        let mut bar = progress::Bar::new("fit");
+        let fit = pollster::block_on(artmesh::fit::object::fit_object(
+            &ctx,
+            dataset,
+            config,
+            &mut |p| bar.show(p),
+        ))
+        .map_err(|e| format!("{id}: {e}"))?;
+        bar.finish();
+        let seconds = start.elapsed().as_secs_f64();
+        let quality = eval::reconstruction_report(
+            &fit.reconstruction,
+            &dataset.gt_meshes,
+            &eval::ChamferOptions::default(),
+        );
+        let metrics = fit
+            .evaluate(dataset, id, category, &eval::EvalOptions::default())
+            .transpose()
+            .map_err(|e| format!("{id}: scoring against the ground truth: {e}"))?;
+        let joints = fit.joint_records();
+        for w in &fit.articulation.warnings {
+            eprintln!("fit: warning: {w}");
+        }
+        for j in &joints {
+            let unit = if j.kind == data::JointKind::Revolute { "°" } else { " m" };
+            eprintln!(
+                "fit: part {}: {:?} joint, axis {:.3?} through {:.3?}, motion {:.3}{unit} (bake-off losses {:.4?})",
+                j.part, j.kind, j.direction, j.origin, j.motion, j.bake_off
+            );
+        }
+        if let Some(m) = &metrics {
+            let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+            eprintln!(
+                "fit: against the ground truth: Axis Ang {} °, Axis Pos {} (0.1 m), Part Motion {}, CD-s {} ({} mm), CD-m {} ({} mm), joint types {}/{} right",
+                f(m.axis_ang),
+                f(m.axis_pos),
+                f(m.part_motion),
+                f(m.cd_s.map(|c| c.cd_peer)),
+                f(m.cd_s.map(|c| c.cd_mm)),
+                f(m.cd_m.map(|c| c.cd_peer)),
+                f(m.cd_m.map(|c| c.cd_mm)),
+                m.joints.len() - m.type_errors,
+                m.joints.len() + m.unmatched_gt.len()
+            );
+        }
+        let report = serde_json::json!({
+            "id": id,
+            "seconds": seconds,
+            "config": config,
+            "joints": joints,
+            "warnings": fit.articulation.warnings,
+            "articulation": {
+                "times": fit.articulation.times,
+                "curve": fit.articulation.curve,
+                "fitted": fit.articulation.joints,
+            },
+            "reconstruction": quality,
+            "metrics": metrics,
+        });
+        let mut files = fit.as_ground_truth().to_files();
+        files.insert("joints.json".into(), to_json(&joints)?.into_bytes());
+        files.insert("report.json".into(), to_json(&report)?.into_bytes());
+        data::write_dir(&files, out).map_err(|e| e.to_string())?;
+        eprintln!(
+            "fit: {:.0} s; wrote joints.json, report.json and {} part meshes to {}",
+            seconds,
+            files.len() - 3,
+            out.display()
+        );
+        Ok(report)
+    }
+
+    /// Both phases' settings of the named preset.
+    fn fit_config(preset: &str) -> Result<artmesh::fit::object::FitConfig, String> {
+        use artmesh::fit::reconstruct::Preset;
+        Ok(artmesh::fit::object::FitConfig::preset(Preset::parse(preset)?))
     }
 
     /// The named preset with the named remeshing mode (`part-aware` or `global`).

@@ -180,7 +180,7 @@ impl KdTree {
     }
 
     fn search(&self, q: glam::DVec3, lo: usize, hi: usize, best: &mut (f64, usize)) {
-        let mut consider = |i: usize, best: &mut (f64, usize)| {
+        let consider = |i: usize, best: &mut (f64, usize)| {
             let d2 = q.distance_squared(self.points[i].as_dvec3());
             if d2 < best.0 {
                 *best = (d2, i);

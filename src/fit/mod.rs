@@ -4,7 +4,9 @@
 //! reconstruction phase per state (densify, prune, anneal, harden, part-aware remeshing,
 //! recovery). The articulation phase builds on its result.
 
+pub mod articulate;
 pub mod init;
+pub mod object;
 pub mod photometric;
 pub mod reconstruct;
 mod subdivide;

@@ -271,6 +271,12 @@ pub enum Phase {
     Densify,
     Remesh,
     Recover,
+    /// Articulation: both joint-type candidates trained on alternating steps.
+    Candidates,
+    /// Articulation: the per-part joint-type decision.
+    BakeOff,
+    /// Articulation: the winners refined with both consistency terms.
+    Refine,
     Done,
 }
 
@@ -282,6 +288,9 @@ impl Phase {
             Phase::Densify => "densify",
             Phase::Remesh => "remesh",
             Phase::Recover => "recover",
+            Phase::Candidates => "candidates",
+            Phase::BakeOff => "bake-off",
+            Phase::Refine => "refine",
             Phase::Done => "done",
         }
     }

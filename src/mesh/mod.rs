@@ -1,7 +1,9 @@
 //! Mesh operations of the reconstruction phase, on the CPU copy of the mesh field: part-aware
 //! restricted Delaunay remeshing ([`restricted_delaunay`], [`part_aware_remesh`]) and the topology
-//! edits around it (densification splits, pruning, hardening, connectivity counts).
+//! edits around it (densification splits, pruning, hardening, connectivity counts), and the
+//! closest-point queries the articulation phase matches vertices with ([`closest`]).
 
+pub mod closest;
 mod restricted_delaunay;
 pub mod topology;
 

@@ -26,6 +26,14 @@ pub fn fresh_folder(out: &Path) -> Result<(), String> {
     }
 }
 
+/// Refuses an existing file: outputs never overwrite the user's files.
+pub fn fresh_file(path: &Path) -> Result<(), String> {
+    if path.exists() {
+        return Err(format!("{} already exists; choose a new file", path.display()));
+    }
+    Ok(())
+}
+
 /// Writes `object` as `<name>.urdf` + `meshes/` below `folder`.
 pub fn write_object(object: &ArticulatedObject, folder: &Path) -> Result<(), String> {
     let files = write_urdf(object, &format!("{}.urdf", object.name)).map_err(|e| e.to_string())?;

@@ -1,0 +1,919 @@
+//! Vertex-wise motion consistency (paper §3.2, "Vertex-wise Motion Consistency"), on the CPU,
+//! one direction at a time.
+//!
+//! Every vertex of a movable part in the source state is carried by its part's rigid motion,
+//! x̂ᵢ = A_p xᵢ + b_p, and compared with the target state's surface of the *same* part at the
+//! closest point: the target's colours and opacities, interpolated there with the closest point's
+//! barycentric weights β, should match the source vertex's own. Matches farther than a threshold
+//! are ignored (the validity indicator ηᵢ of the paper):
+//!
+//! L = 1/|V| Σᵢ ηᵢ [λ_c ‖cᵢ − Σⱼ βᵢⱼ cⱼ‖² + λ_σ (σᵢ − Σⱼ βᵢⱼ σⱼ)²].
+//!
+//! Attributes are constants here, so the loss reaches the motion only through where x̂ᵢ lands on
+//! the target triangle, i.e. through β(x̂ᵢ). The per-vertex gradients gᵢ = ∂L/∂x̂ᵢ are reduced to
+//! [`PartSums`] (Σ gᵢ, Σ gᵢ xᵢᵀ with xᵢ before the motion), which is all the motion parameters
+//! need. The forward direction (t₁ → t₂) passes the forward motions; the backward direction
+//! swaps the surfaces and passes the analytic inverses (Aᵀ, −Aᵀ b).
+
+use glam::{DMat3, DVec3, Vec3};
+
+use super::PartSums;
+use crate::mesh::closest::TriangleBvh;
+use crate::raster::{MeshField, SH_C0, SH_FLOATS};
+
+/// One articulation state's mesh as the vertex-wise term sees it: per-vertex position, colour,
+/// opacity and hardened part label, with one closest-point tree per part.
+#[derive(Debug, Clone)]
+pub struct StateSurface {
+    positions: Vec<Vec3>,
+    faces: Vec<[u32; 3]>,
+    parts: Vec<u32>,
+    colors: Vec<Vec3>,
+    opacity: Vec<f32>,
+    num_parts: usize,
+    /// Per part: indices into `faces` of its faces, in the order its tree names them.
+    part_faces: Vec<Vec<u32>>,
+    /// Per part: the tree over exactly those faces.
+    part_trees: Vec<TriangleBvh>,
+    /// Faces whose vertices carry different labels (left out of every tree).
+    cross_part_faces: usize,
+}
+
+impl StateSurface {
+    /// A state surface from per-vertex arrays (`parts` in 0..`num_parts`, 0 the static base;
+    /// `colors` RGB; `opacity` in [0, 1]). A face belongs to the part its three vertices share;
+    /// faces whose vertices disagree are left out of the search (part-aware remeshing leaves
+    /// none) and counted in [`Self::cross_part_faces`].
+    ///
+    /// Errors (never panics) on mismatched lengths, out-of-range indices or labels, non-finite
+    /// positions or colours, and opacities outside [0, 1].
+    pub fn new(
+        positions: Vec<Vec3>,
+        faces: Vec<[u32; 3]>,
+        parts: Vec<u32>,
+        colors: Vec<Vec3>,
+        opacity: Vec<f32>,
+        num_parts: usize,
+    ) -> Result<Self, String> {
+        let n = positions.len();
+        if num_parts == 0 {
+            return Err("num_parts is 0, expected at least 1 (the static base)".into());
+        }
+        if u32::try_from(n).is_err() {
+            return Err(format!("{n} vertices do not fit u32 face indices"));
+        }
+        for (what, len) in [
+            ("parts", parts.len()),
+            ("colors", colors.len()),
+            ("opacity", opacity.len()),
+        ] {
+            if len != n {
+                return Err(format!(
+                    "{what} has {len} values, expected one per vertex ({n})"
+                ));
+            }
+        }
+        if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
+            return Err(format!(
+                "vertex {v} has a non-finite position {}",
+                positions[v]
+            ));
+        }
+        if let Some(v) = colors.iter().position(|c| !c.is_finite()) {
+            return Err(format!("vertex {v} has a non-finite colour {}", colors[v]));
+        }
+        if let Some(v) = opacity.iter().position(|o| !(0.0..=1.0).contains(o)) {
+            return Err(format!(
+                "vertex {v} has opacity {}, expected a value in [0, 1]",
+                opacity[v]
+            ));
+        }
+        if let Some(v) = parts.iter().position(|&p| p as usize >= num_parts) {
+            return Err(format!(
+                "vertex {v} has part {}, expected 0 to {}",
+                parts[v],
+                num_parts - 1
+            ));
+        }
+        if let Some(f) = faces
+            .iter()
+            .position(|f| f.iter().any(|&v| v as usize >= n))
+        {
+            return Err(format!(
+                "face {f} is {:?}, but there are only {n} vertices",
+                faces[f]
+            ));
+        }
+
+        let mut part_faces = vec![Vec::new(); num_parts];
+        let mut cross_part_faces = 0;
+        for (f, face) in faces.iter().enumerate() {
+            let [a, b, c] = face.map(|v| parts[v as usize]);
+            if a == b && b == c {
+                part_faces[a as usize].push(f as u32);
+            } else {
+                cross_part_faces += 1;
+            }
+        }
+        let part_trees = part_faces
+            .iter()
+            .map(|indices| {
+                let own: Vec<[u32; 3]> = indices.iter().map(|&f| faces[f as usize]).collect();
+                TriangleBvh::new(&positions, &own)
+            })
+            .collect();
+        Ok(Self {
+            positions,
+            faces,
+            parts,
+            colors,
+            opacity,
+            num_parts,
+            part_faces,
+            part_trees,
+            cross_part_faces,
+        })
+    }
+
+    /// The state surface of a mesh field: hardened part labels, view-independent (degree-0 SH)
+    /// colour and sigmoid opacity.
+    pub fn from_field(field: &MeshField) -> Result<Self, String> {
+        field.validate()?;
+        let parts = crate::mesh::topology::harden_parts(field);
+        let colors = field
+            .sh
+            .chunks_exact(SH_FLOATS)
+            .map(|sh| Vec3::new(sh[0], sh[1], sh[2]) * SH_C0 + 0.5)
+            .collect();
+        let opacity = field
+            .opacity
+            .iter()
+            .map(|&logit| 1.0 / (1.0 + (-logit).exp()))
+            .collect();
+        Self::new(
+            field.positions.clone(),
+            field.faces.clone(),
+            parts,
+            colors,
+            opacity,
+            field.num_parts,
+        )
+    }
+
+    /// Number of vertices.
+    pub fn num_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    /// Number of parts K + 1, static base included.
+    pub fn num_parts(&self) -> usize {
+        self.num_parts
+    }
+
+    /// Vertex positions.
+    pub fn positions(&self) -> &[Vec3] {
+        &self.positions
+    }
+
+    /// Faces (vertex indices).
+    pub fn faces(&self) -> &[[u32; 3]] {
+        &self.faces
+    }
+
+    /// Hardened part label per vertex.
+    pub fn parts(&self) -> &[u32] {
+        &self.parts
+    }
+
+    /// Colour per vertex.
+    pub fn colors(&self) -> &[Vec3] {
+        &self.colors
+    }
+
+    /// Opacity per vertex.
+    pub fn opacity(&self) -> &[f32] {
+        &self.opacity
+    }
+
+    /// Number of faces of part `part` (0 for a label out of range).
+    pub fn part_face_count(&self, part: usize) -> usize {
+        self.part_faces.get(part).map_or(0, Vec::len)
+    }
+
+    /// Faces left out of the search because their vertices carry different labels.
+    pub fn cross_part_faces(&self) -> usize {
+        self.cross_part_faces
+    }
+}
+
+/// The weights of the vertex-wise term: λ_c, λ_σ and the validity threshold η.
+///
+/// The paper gives no values for any of them; the defaults weigh colour and opacity equally and
+/// accept matches within 2 cm, a few triangle sizes of a remeshed tabletop object.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct VertexMotionWeights {
+    /// λ_c, weight of the squared colour difference.
+    pub color: f32,
+    /// λ_σ, weight of the squared opacity difference.
+    pub opacity: f32,
+    /// Largest closest-point distance (metres) of a valid match.
+    pub max_distance: f32,
+}
+
+impl Default for VertexMotionWeights {
+    fn default() -> Self {
+        Self {
+            color: 1.0,
+            opacity: 1.0,
+            max_distance: 0.02,
+        }
+    }
+}
+
+/// The vertex-wise term in one direction and its gradient with respect to the part motions.
+#[derive(Debug, Clone, PartialEq)]
+pub struct VertexMotionLoss {
+    /// L, normalised by the source's total vertex count as in the paper.
+    pub loss: f64,
+    /// Source vertices with a match within the distance threshold.
+    pub valid: usize,
+    /// Source vertices searched: those of movable parts whose target part has faces.
+    pub considered: usize,
+    /// Per part (`source.num_parts()` entries, part 0 always zero): Σ gᵢ and Σ gᵢ xᵢᵀ over the
+    /// valid vertices, with gᵢ = ∂L/∂x̂ᵢ. By the chain rule through x̂ = A x + b these are ∂L/∂b
+    /// and ∂L/∂A of that part's motion.
+    pub per_part: Vec<PartSums>,
+}
+
+/// The vertex-wise motion consistency from `source` to `target`.
+///
+/// `motions[k] = (A_k, b_k)` carries part k of the source onto the target (x̂ = A_k x + b_k);
+/// index 0, the static base, is never read but must be present. A_k is normally a rotation, but
+/// nothing here relies on it: the gradient is with respect to all nine entries. For the backward
+/// direction pass the surfaces swapped and the inverse motions (A_kᵀ, −A_kᵀ b_k).
+///
+/// Errors when the surfaces disagree on the number of parts, `motions` is too short or not
+/// finite where used, or a weight is negative or not finite.
+pub fn vertex_motion_loss(
+    source: &StateSurface,
+    target: &StateSurface,
+    motions: &[(DMat3, DVec3)],
+    weights: &VertexMotionWeights,
+) -> Result<VertexMotionLoss, String> {
+    let num_parts = source.num_parts;
+    if target.num_parts != num_parts {
+        return Err(format!(
+            "the source has {num_parts} parts but the target {}",
+            target.num_parts
+        ));
+    }
+    if motions.len() < num_parts {
+        return Err(format!(
+            "{} motions for {num_parts} parts (one per part, the static base included)",
+            motions.len()
+        ));
+    }
+    if let Some(k) =
+        (1..num_parts).find(|&k| !(motions[k].0.is_finite() && motions[k].1.is_finite()))
+    {
+        return Err(format!("the motion of part {k} is not finite"));
+    }
+    for (what, value) in [
+        ("color", weights.color),
+        ("opacity", weights.opacity),
+        ("max_distance", weights.max_distance),
+    ] {
+        if !(value.is_finite() && value >= 0.0) {
+            return Err(format!(
+                "weight {what} is {value}, expected a finite value ≥ 0"
+            ));
+        }
+    }
+
+    let mut result = VertexMotionLoss {
+        loss: 0.0,
+        valid: 0,
+        considered: 0,
+        per_part: vec![PartSums::default(); num_parts],
+    };
+    if source.positions.is_empty() {
+        return Ok(result);
+    }
+    let inv_n = 1.0 / source.positions.len() as f64;
+    let max_d2 = f64::from(weights.max_distance).powi(2);
+    let (lambda_c, lambda_s) = (f64::from(weights.color), f64::from(weights.opacity));
+
+    for (i, &x) in source.positions.iter().enumerate() {
+        let part = source.parts[i] as usize;
+        // The static base does not move; a part absent from the target has nothing to match.
+        if part == 0 || target.part_trees[part].is_empty() {
+            continue;
+        }
+        result.considered += 1;
+        let x = x.as_dvec3();
+        let (a, b) = motions[part];
+        let moved = a * x + b;
+        let Some(m) = closest_on_part(target, part, moved) else {
+            continue;
+        };
+        if m.distance_squared > max_d2 {
+            continue;
+        }
+        result.valid += 1;
+
+        // Interpolated target attributes and the residuals against the source vertex.
+        let corner_color = m.corners.map(|v| target.colors[v as usize].as_dvec3());
+        let corner_opacity = m.corners.map(|v| f64::from(target.opacity[v as usize]));
+        let color: DVec3 = (0..3).map(|j| corner_color[j] * m.beta[j]).sum();
+        let opacity: f64 = (0..3).map(|j| corner_opacity[j] * m.beta[j]).sum();
+        let dc = source.colors[i].as_dvec3() - color;
+        let ds = f64::from(source.opacity[i]) - opacity;
+        result.loss += inv_n * (lambda_c * dc.length_squared() + lambda_s * ds * ds);
+
+        // ∂term/∂βⱼ = −2 (λ_c dc·cⱼ + λ_σ ds σⱼ), then through ∂β/∂x̂ of the region.
+        let g: DVec3 = (0..3)
+            .map(|j| {
+                let d_beta =
+                    -2.0 * (lambda_c * dc.dot(corner_color[j]) + lambda_s * ds * corner_opacity[j]);
+                m.grad_beta[j] * d_beta
+            })
+            .sum();
+        result.per_part[part].add(g * inv_n, x);
+    }
+    Ok(result)
+}
+
+/// The Voronoi region of a target triangle a moved vertex landed in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Region {
+    Face,
+    /// The edge between two corners (positions in the face).
+    Edge(usize, usize),
+    Vertex(usize),
+}
+
+/// A moved vertex's match on the target, in f64: the tree (f32) picks the face and the region,
+/// then β, ∂β/∂x̂ and the distance are evaluated here from x̂ in double precision, so the loss is
+/// one smooth function per region and its gradient is exactly that function's.
+#[derive(Debug, Clone, Copy)]
+struct Match {
+    /// The target face's vertex indices.
+    corners: [u32; 3],
+    /// Only the tests read it back (to check a perturbation keeps every vertex in its region).
+    #[cfg_attr(not(test), expect(dead_code))]
+    region: Region,
+    beta: [f64; 3],
+    grad_beta: [DVec3; 3],
+    distance_squared: f64,
+}
+
+/// The closest point to `moved` on `target`'s faces of `part` (a part with at least one face).
+fn closest_on_part(target: &StateSurface, part: usize, moved: DVec3) -> Option<Match> {
+    let hit = target.part_trees[part].closest(moved.as_vec3())?;
+    let face = target.part_faces[part][hit.face as usize];
+    let corners = target.faces[face as usize];
+    let p = corners.map(|v| target.positions[v as usize].as_dvec3());
+
+    // closest_point_on_triangle reports off-face regions with exact zero weights.
+    let w = hit.barycentric.to_array();
+    let mut region = match w.map(|x| x == 0.0) {
+        [false, false, false] => Region::Face,
+        [true, false, false] => Region::Edge(1, 2),
+        [false, true, false] => Region::Edge(2, 0),
+        [false, false, true] => Region::Edge(0, 1),
+        _ => Region::Vertex(w.iter().position(|&x| x != 0.0).unwrap_or(0)),
+    };
+
+    let mut beta = [0.0; 3];
+    let mut grad_beta = [DVec3::ZERO; 3];
+    if region == Region::Face {
+        // β of the projection onto the plane, linear in x̂: with n = e₁ × e₂ and d = x̂ − a,
+        // β_b = n·(d × e₂)/|n|² = d·(e₂ × n)/|n|², β_c = d·(n × e₁)/|n|², β_a = 1 − β_b − β_c.
+        let (e1, e2) = (p[1] - p[0], p[2] - p[0]);
+        let n = e1.cross(e2);
+        let nn = n.length_squared();
+        if nn > 0.0 {
+            grad_beta[1] = e2.cross(n) / nn;
+            grad_beta[2] = n.cross(e1) / nn;
+            grad_beta[0] = -(grad_beta[1] + grad_beta[2]);
+            let d = moved - p[0];
+            beta[1] = d.dot(grad_beta[1]);
+            beta[2] = d.dot(grad_beta[2]);
+            beta[0] = 1.0 - beta[1] - beta[2];
+        } else {
+            // Degenerate in f64 though not in f32: keep the tree's weights, held fixed.
+            region = Region::Vertex(0);
+            beta = w.map(f64::from);
+        }
+    }
+    if let Region::Edge(i, j) = region {
+        // The 1-D projection parameter t = (x̂ − pᵢ)·e/|e|² along e = pⱼ − pᵢ: βⱼ = t, βᵢ = 1 − t.
+        let e = p[j] - p[i];
+        let ee = e.length_squared();
+        if ee > 0.0 {
+            let t = (moved - p[i]).dot(e) / ee;
+            beta[i] = 1.0 - t;
+            beta[j] = t;
+            grad_beta[j] = e / ee;
+            grad_beta[i] = -e / ee;
+        } else {
+            region = Region::Vertex(i);
+        }
+    }
+    if let Region::Vertex(k) = region {
+        // The closest point is a corner (or a fixed blend of a degenerate face): β is constant.
+        if beta == [0.0; 3] {
+            beta[k] = 1.0;
+        }
+        grad_beta = [DVec3::ZERO; 3];
+    }
+    let point: DVec3 = (0..3).map(|j| p[j] * beta[j]).sum();
+    Some(Match {
+        corners,
+        region,
+        beta,
+        grad_beta,
+        distance_squared: (moved - point).length_squared(),
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    /// An n × n grid patch on [0, size]² with a smooth bump, all vertices of one part; colour and
+    /// opacity smooth functions of position.
+    fn bumpy_patch(n: usize, size: f32, part: u32, num_parts: usize) -> StateSurface {
+        let mut positions = Vec::new();
+        for j in 0..=n {
+            for i in 0..=n {
+                let (u, v) = (i as f32 / n as f32, j as f32 / n as f32);
+                let z = 0.004 * (3.0 * u).sin() * (2.5 * v + 0.3).cos();
+                positions.push(Vec3::new(u * size, v * size, z));
+            }
+        }
+        let mut faces = Vec::new();
+        let row = n as u32 + 1;
+        for j in 0..n as u32 {
+            for i in 0..n as u32 {
+                let v = j * row + i;
+                faces.push([v, v + 1, v + row + 1]);
+                faces.push([v, v + row + 1, v + row]);
+            }
+        }
+        let colors = positions
+            .iter()
+            .map(|p| {
+                Vec3::new(
+                    0.5 + 2.0 * p.x,
+                    0.3 + 1.5 * p.y,
+                    0.4 + (20.0 * p.x * p.y).sin() * 0.3,
+                )
+            })
+            .collect();
+        let opacity = positions
+            .iter()
+            .map(|p| 0.6 + 0.3 * (8.0 * p.x + 5.0 * p.y).sin())
+            .collect();
+        let parts = vec![part; positions.len()];
+        StateSurface::new(positions, faces, parts, colors, opacity, num_parts).unwrap()
+    }
+
+    fn identity_motions(num_parts: usize) -> Vec<(DMat3, DVec3)> {
+        vec![(DMat3::IDENTITY, DVec3::ZERO); num_parts]
+    }
+
+    /// A rotation by `angle` about `axis` then a translation.
+    fn rigid(axis: DVec3, angle: f64, t: DVec3) -> (DMat3, DVec3) {
+        (DMat3::from_axis_angle(axis.normalize(), angle), t)
+    }
+
+    #[test]
+    fn identical_surfaces_under_identity_agree() {
+        let s = bumpy_patch(6, 0.1, 1, 2);
+        let out = vertex_motion_loss(
+            &s,
+            &s,
+            &identity_motions(2),
+            &VertexMotionWeights::default(),
+        )
+        .unwrap();
+        assert_eq!(out.considered, s.num_vertices());
+        assert_eq!(out.valid, s.num_vertices());
+        assert!(out.loss.abs() < 1e-12, "{}", out.loss);
+        assert_eq!(out.per_part.len(), 2);
+        assert_eq!(out.per_part[1].count as usize, s.num_vertices());
+        assert!(out.per_part[1].g.length() < 1e-9);
+    }
+
+    #[test]
+    fn far_away_motion_matches_nothing() {
+        let s = bumpy_patch(4, 0.1, 1, 2);
+        let mut motions = identity_motions(2);
+        motions[1].1 = DVec3::new(0.0, 0.0, 0.5);
+        let out = vertex_motion_loss(&s, &s, &motions, &VertexMotionWeights::default()).unwrap();
+        assert_eq!(out.considered, s.num_vertices());
+        assert_eq!(out.valid, 0);
+        assert_eq!(out.loss, 0.0);
+        assert_eq!(out.per_part[1], PartSums::default());
+    }
+
+    #[test]
+    fn static_base_and_missing_parts_are_skipped() {
+        // Part 0 (base) vertices never move or match; part 2 has no target faces.
+        let base = bumpy_patch(3, 0.1, 0, 3);
+        let out = vertex_motion_loss(
+            &base,
+            &base,
+            &identity_motions(3),
+            &VertexMotionWeights::default(),
+        )
+        .unwrap();
+        assert_eq!((out.considered, out.valid, out.loss), (0, 0, 0.0));
+        let moving = bumpy_patch(3, 0.1, 2, 3);
+        let target = bumpy_patch(3, 0.1, 1, 3);
+        let out = vertex_motion_loss(
+            &moving,
+            &target,
+            &identity_motions(3),
+            &VertexMotionWeights::default(),
+        )
+        .unwrap();
+        assert_eq!((out.considered, out.valid), (0, 0));
+    }
+
+    /// Source points off a target surface: chosen on target faces (barycentrics in [lo, 1 − 2 lo]
+    /// of a random face, or pushed outward past a boundary edge when `past_edge`), lifted along
+    /// the normal by `lift`, and carried back by the inverse of `motion` so the motion returns
+    /// them there. Colours and opacities differ from the target's.
+    fn source_near(
+        target: &StateSurface,
+        motion: (DMat3, DVec3),
+        count: usize,
+        past_edge: f32,
+        lift: f32,
+        seed: u64,
+    ) -> StateSurface {
+        let mut rng = Rng::new(seed);
+        let (a_inv, b_inv) = (motion.0.inverse(), -motion.0.inverse() * motion.1);
+        let mut positions = Vec::new();
+        for _ in 0..count {
+            let f = rng.below(target.faces.len() as u32) as usize;
+            let [a, b, c] = target.faces[f].map(|v| target.positions[v as usize]);
+            let (mut u, mut v) = (rng.uniform(0.15, 0.7), rng.uniform(0.15, 0.7));
+            if u + v > 0.85 {
+                (u, v) = (0.85 - v, 0.85 - u);
+            }
+            let n = (b - a).cross(c - a).normalize();
+            let on = a + (b - a) * u + (c - a) * v;
+            // Past the edge ab (opposite c), in the plane: an edge region of a lone triangle.
+            let out = if past_edge > 0.0 {
+                let e = (b - a).normalize();
+                let away = e.cross(n).normalize();
+                let towards_c = (c - a).dot(away);
+                a + e * (b - a).length() * rng.uniform(0.2, 0.8)
+                    - away * towards_c.signum() * past_edge
+            } else {
+                on
+            };
+            let p = (out + n * lift * rng.uniform(0.5, 1.0)).as_dvec3();
+            positions.push((a_inv * p + b_inv).as_vec3());
+        }
+        let colors = positions
+            .iter()
+            .map(|_| Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32()))
+            .collect();
+        let opacity = positions.iter().map(|_| rng.next_f32()).collect();
+        let parts = vec![1; count];
+        StateSurface::new(
+            positions,
+            Vec::new(),
+            parts,
+            colors,
+            opacity,
+            target.num_parts,
+        )
+        .unwrap()
+    }
+
+    /// Central differences of L over the 12 entries of part 1's (A, b) against the analytic
+    /// Σ gᵢ xᵢᵀ and Σ gᵢ, after checking that no vertex changes face, region or validity.
+    fn check_gradient(
+        source: &StateSurface,
+        target: &StateSurface,
+        motion: (DMat3, DVec3),
+        weights: &VertexMotionWeights,
+    ) {
+        let h = 1e-4;
+        let run = |m: (DMat3, DVec3)| {
+            let mut motions = identity_motions(source.num_parts);
+            motions[1] = m;
+            vertex_motion_loss(source, target, &motions, weights).unwrap()
+        };
+        let matches = |m: (DMat3, DVec3)| -> Vec<Option<([u32; 3], Region)>> {
+            source
+                .positions
+                .iter()
+                .map(|x| {
+                    let moved = m.0 * x.as_dvec3() + m.1;
+                    closest_on_part(target, 1, moved)
+                        .filter(|hit| {
+                            hit.distance_squared <= f64::from(weights.max_distance).powi(2)
+                        })
+                        .map(|hit| (hit.corners, hit.region))
+                })
+                .collect()
+        };
+        let base = run(motion);
+        let base_matches = matches(motion);
+        assert!(base.valid > 0 && base.loss > 0.0);
+        let analytic = base.per_part[1];
+        let scale = analytic
+            .gx
+            .to_cols_array()
+            .iter()
+            .chain(analytic.g.to_array().iter())
+            .fold(0.0f64, |m, v| m.max(v.abs()));
+        assert!(scale > 0.0);
+        for entry in 0..12 {
+            let shifted = |s: f64| {
+                let (mut a, mut b) = motion;
+                if entry < 9 {
+                    a.col_mut(entry / 3)[entry % 3] += s;
+                } else {
+                    b[entry - 9] += s;
+                }
+                (a, b)
+            };
+            for s in [h, -h] {
+                assert_eq!(
+                    matches(shifted(s)),
+                    base_matches,
+                    "entry {entry} moves a vertex across a region"
+                );
+            }
+            let numeric = (run(shifted(h)).loss - run(shifted(-h)).loss) / (2.0 * h);
+            let exact = if entry < 9 {
+                analytic.gx.col(entry / 3)[entry % 3]
+            } else {
+                analytic.g[entry - 9]
+            };
+            assert!(
+                (numeric - exact).abs() <= 1e-6 * scale,
+                "entry {entry}: numeric {numeric} vs analytic {exact} (scale {scale})"
+            );
+        }
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences_in_face_regions() {
+        let target = bumpy_patch(8, 0.2, 1, 2);
+        let truth = rigid(
+            DVec3::new(0.3, -0.5, 1.0),
+            0.4,
+            DVec3::new(0.05, -0.02, 0.1),
+        );
+        let source = source_near(&target, truth, 300, 0.0, 0.002, 11);
+        // A slightly wrong motion, as during optimisation.
+        let nudge = rigid(
+            DVec3::new(1.0, 0.2, 0.1),
+            0.002,
+            DVec3::new(0.0003, -0.0002, 0.0001),
+        );
+        let motion = (nudge.0 * truth.0, nudge.0 * truth.1 + nudge.1);
+        let weights = VertexMotionWeights {
+            color: 0.7,
+            opacity: 1.3,
+            max_distance: 0.02,
+        };
+        let out = vertex_motion_loss(&source, &target, &[truth, motion], &weights).unwrap();
+        assert_eq!(out.valid, 300);
+        check_gradient(&source, &target, motion, &weights);
+    }
+
+    #[test]
+    fn gradient_matches_finite_differences_in_edge_regions() {
+        // One lone triangle: points past its edge ab land in that edge's region.
+        let target = StateSurface::new(
+            vec![
+                Vec3::new(0.0, 0.0, 0.0),
+                Vec3::new(0.05, 0.01, 0.006),
+                Vec3::new(0.01, 0.04, 0.01),
+            ],
+            vec![[0, 1, 2]],
+            vec![1; 3],
+            vec![
+                Vec3::new(1.0, 0.2, 0.0),
+                Vec3::new(0.0, 0.9, 0.3),
+                Vec3::new(0.2, 0.1, 0.8),
+            ],
+            vec![0.9, 0.2, 0.5],
+            2,
+        )
+        .unwrap();
+        let truth = rigid(
+            DVec3::new(-0.2, 1.0, 0.4),
+            -0.3,
+            DVec3::new(-0.03, 0.01, 0.02),
+        );
+        let source = source_near(&target, truth, 50, 0.004, 0.002, 5);
+        let nudge = rigid(
+            DVec3::new(0.0, 0.3, 1.0),
+            0.001,
+            DVec3::new(0.0001, 0.0002, -0.0001),
+        );
+        let motion = (nudge.0 * truth.0, nudge.0 * truth.1 + nudge.1);
+        let weights = VertexMotionWeights::default();
+        let mut motions = identity_motions(2);
+        motions[1] = motion;
+        for x in &source.positions {
+            let hit = closest_on_part(&target, 1, motion.0 * x.as_dvec3() + motion.1).unwrap();
+            assert_eq!(hit.region, Region::Edge(0, 1));
+        }
+        check_gradient(&source, &target, motion, &weights);
+    }
+
+    #[test]
+    fn matches_stay_within_the_same_part() {
+        // A part-1 triangle 1 cm below the source vertex, a part-2 triangle 1 mm below it.
+        let red = Vec3::new(1.0, 0.0, 0.0);
+        let green = Vec3::new(0.0, 1.0, 0.0);
+        let tri = |z: f32| {
+            [
+                Vec3::new(-0.05, -0.05, z),
+                Vec3::new(0.05, -0.05, z),
+                Vec3::new(0.0, 0.05, z),
+            ]
+        };
+        let positions: Vec<Vec3> = tri(-0.01).into_iter().chain(tri(-0.001)).collect();
+        let target = StateSurface::new(
+            positions,
+            vec![[0, 1, 2], [3, 4, 5]],
+            vec![1, 1, 1, 2, 2, 2],
+            vec![red, red, red, green, green, green],
+            vec![1.0; 6],
+            3,
+        )
+        .unwrap();
+        let source = StateSurface::new(
+            vec![Vec3::ZERO],
+            Vec::new(),
+            vec![1],
+            vec![red],
+            vec![1.0],
+            3,
+        )
+        .unwrap();
+        let out = vertex_motion_loss(
+            &source,
+            &target,
+            &identity_motions(3),
+            &VertexMotionWeights::default(),
+        )
+        .unwrap();
+        assert_eq!(out.valid, 1);
+        assert!(
+            out.loss.abs() < 1e-12,
+            "matched the wrong part: loss {}",
+            out.loss
+        );
+        let hit = closest_on_part(&target, 1, DVec3::ZERO).unwrap();
+        assert_eq!(hit.corners, [0, 1, 2]);
+        assert!((hit.distance_squared.sqrt() - 0.01).abs() < 1e-6);
+        // The same vertex labelled 2 matches the green triangle instead.
+        let source2 = StateSurface::new(
+            vec![Vec3::ZERO],
+            Vec::new(),
+            vec![2],
+            vec![red],
+            vec![1.0],
+            3,
+        )
+        .unwrap();
+        let out = vertex_motion_loss(
+            &source2,
+            &target,
+            &identity_motions(3),
+            &VertexMotionWeights::default(),
+        )
+        .unwrap();
+        assert!((out.loss - 2.0).abs() < 1e-6, "{}", out.loss);
+        assert_eq!(out.per_part[1], PartSums::default());
+    }
+
+    #[test]
+    fn cross_part_faces_are_left_out() {
+        let s = StateSurface::new(
+            vec![Vec3::ZERO, Vec3::X, Vec3::Y, Vec3::ONE],
+            vec![[0, 1, 2], [1, 3, 2]],
+            vec![1, 1, 1, 2],
+            vec![Vec3::ZERO; 4],
+            vec![0.5; 4],
+            3,
+        )
+        .unwrap();
+        assert_eq!(s.cross_part_faces(), 1);
+        assert_eq!(
+            (
+                s.part_face_count(1),
+                s.part_face_count(2),
+                s.part_face_count(9)
+            ),
+            (1, 0, 0)
+        );
+    }
+
+    #[test]
+    fn bad_input_is_an_error() {
+        let p = vec![Vec3::ZERO, Vec3::X, Vec3::Y];
+        let make = |positions: Vec<Vec3>,
+                    faces: Vec<[u32; 3]>,
+                    parts: Vec<u32>,
+                    colors: usize,
+                    opacity: Vec<f32>,
+                    k: usize| {
+            StateSurface::new(
+                positions,
+                faces,
+                parts,
+                vec![Vec3::ZERO; colors],
+                opacity,
+                k,
+            )
+        };
+        let ok = || make(p.clone(), vec![[0, 1, 2]], vec![1; 3], 3, vec![0.5; 3], 2);
+        assert!(ok().is_ok());
+        for bad in [
+            make(p.clone(), vec![[0, 1, 2]], vec![1; 2], 3, vec![0.5; 3], 2),
+            make(p.clone(), vec![[0, 1, 2]], vec![1; 3], 4, vec![0.5; 3], 2),
+            make(p.clone(), vec![[0, 1, 2]], vec![1; 3], 3, vec![0.5; 1], 2),
+            make(p.clone(), vec![[0, 1, 3]], vec![1; 3], 3, vec![0.5; 3], 2),
+            make(
+                p.clone(),
+                vec![[0, 1, 2]],
+                vec![1, 2, 1],
+                3,
+                vec![0.5; 3],
+                2,
+            ),
+            make(p.clone(), vec![[0, 1, 2]], vec![0; 3], 3, vec![0.5; 3], 0),
+            make(
+                p.clone(),
+                vec![[0, 1, 2]],
+                vec![1; 3],
+                3,
+                vec![0.5, 1.5, 0.5],
+                2,
+            ),
+            make(
+                vec![Vec3::ZERO, Vec3::NAN, Vec3::Y],
+                vec![[0, 1, 2]],
+                vec![1; 3],
+                3,
+                vec![0.5; 3],
+                2,
+            ),
+        ] {
+            let err = bad.unwrap_err();
+            assert!(!err.is_empty());
+        }
+        let s = ok().unwrap();
+        let w = VertexMotionWeights::default();
+        assert!(
+            vertex_motion_loss(&s, &s, &identity_motions(1), &w)
+                .unwrap_err()
+                .contains("motions")
+        );
+        assert!(vertex_motion_loss(&s, &s, &[], &w).is_err());
+        let other = make(p.clone(), vec![[0, 1, 2]], vec![1; 3], 3, vec![0.5; 3], 3).unwrap();
+        assert!(vertex_motion_loss(&s, &other, &identity_motions(3), &w).is_err());
+        let mut nan_motion = identity_motions(2);
+        nan_motion[1].1.x = f64::NAN;
+        assert!(vertex_motion_loss(&s, &s, &nan_motion, &w).is_err());
+        let bad_weights = VertexMotionWeights {
+            max_distance: -1.0,
+            ..w
+        };
+        assert!(vertex_motion_loss(&s, &s, &identity_motions(2), &bad_weights).is_err());
+        // A field with inconsistent arrays is refused too.
+        let mut field = MeshField::new(p.clone(), vec![[0, 1, 2]], 2, 0.0);
+        field.opacity.pop();
+        assert!(StateSurface::from_field(&field).is_err());
+    }
+
+    #[test]
+    fn from_field_reads_colour_opacity_and_parts() {
+        let mut field = MeshField::new(vec![Vec3::ZERO, Vec3::X, Vec3::Y], vec![[0, 1, 2]], 3, 0.0);
+        field.set_color(1, Vec3::new(0.2, 0.6, 0.9));
+        field.opacity[2] = 2.0;
+        field.part_logits[3 + 2] = 1.0; // vertex 1's logit of part 2
+        let s = StateSurface::from_field(&field).unwrap();
+        assert_eq!(s.parts(), &[0, 2, 0]);
+        assert!((s.colors()[1] - Vec3::new(0.2, 0.6, 0.9)).length() < 1e-6);
+        assert!((s.colors()[0] - Vec3::splat(0.5)).length() < 1e-6);
+        assert!((s.opacity()[0] - 0.5).abs() < 1e-6);
+        assert!((s.opacity()[2] - 1.0 / (1.0 + (-2.0f32).exp())).abs() < 1e-6);
+        assert_eq!(s.cross_part_faces(), 1);
+    }
+}

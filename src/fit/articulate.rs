@@ -1,0 +1,781 @@
+//! The articulation phase (paper §3.2 and appendix "Training Details"): the two reconstructed
+//! states' meshes are frozen and only the [`ArticulationField`] — one rigid motion per movable
+//! part — is optimised.
+//!
+//! Schedule over `iterations` steps:
+//! 1. **Candidates** (until `decide_at`): a revolute and a prismatic candidate per part, both
+//!    seeded by [`initial_candidates`], trained on alternating steps by the forward pixel-wise
+//!    motion consistency (state t₁'s mesh moved by g⁺, rendered from a state-t₂ camera).
+//! 2. **Bake-off** at `decide_at`: per part, the loss masked to the part's pixels in state t₂ with
+//!    only that part moved by each candidate, averaged over all state-t₂ views; the lower wins
+//!    (ties to revolute, as in the paper). The winner's Adam moments start from zero.
+//! 3. **Refine**: the winners with type-masked gradients, the backward pixel-wise term (state
+//!    t₂'s mesh moved by the analytic inverse g⁻, rendered from state-t₁ cameras) from
+//!    `backward_from`, and the vertex-wise term in both directions.
+//!
+//! The pixel-wise gradients come back as per-part [`PartSums`] from the GPU
+//! ([`MovedMesh::read_sums`]), the vertex-wise ones from the CPU; [`PartMotion::gradient`] turns
+//! both into parameter gradients.
+
+use glam::{DMat3, DVec3, Vec3};
+use serde::Serialize;
+
+use super::reconstruct::{Phase, Preset, Progress, Reconstruction, training_views};
+use crate::articulation::init::{JointCandidates, initial_candidates, principal_frame};
+use crate::articulation::kernels::{MotionKernels, MovedMesh};
+use crate::articulation::vertex_motion::{StateSurface, VertexMotionWeights, vertex_motion_loss};
+use crate::articulation::{MotionAdam, MotionMask, MotionRates, PartMotion, PartSums};
+use crate::data::{Camera, Dataset, Frame, GtJoint, JointKind, State};
+use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
+use crate::loss::{ImageLoss, LossWeights, SSIM_C1, SSIM_C2, TargetImages, TargetView, ssim_taps};
+use crate::raster::{GpuField, MeshField, RasterSettings, RasterState, Rasterizer};
+use crate::rng::Rng;
+
+/// Which parts of the motion-consistency objective are on (the paper's Table 4 ablations; the
+/// fourth, part-aware remeshing, is [`super::reconstruct::RemeshMode`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Ablation {
+    /// The vertex-wise colour term.
+    pub vertex_color: bool,
+    /// The vertex-wise opacity term.
+    pub vertex_opacity: bool,
+    /// The backward direction (backward pixel-wise and vertex-wise terms).
+    pub backward: bool,
+}
+
+impl Ablation {
+    /// The full model.
+    pub const FULL: Ablation = Ablation {
+        vertex_color: true,
+        vertex_opacity: true,
+        backward: true,
+    };
+
+    /// The ablation named as on the command line (`full`, `no-vertex-color`, `no-vertex-opacity`,
+    /// `no-backward`).
+    pub fn parse(name: &str) -> Result<Ablation, String> {
+        let full = Ablation::FULL;
+        Ok(match name {
+            "full" => full,
+            "no-vertex-color" => Ablation {
+                vertex_color: false,
+                ..full
+            },
+            "no-vertex-opacity" => Ablation {
+                vertex_opacity: false,
+                ..full
+            },
+            "no-backward" => Ablation {
+                backward: false,
+                ..full
+            },
+            other => {
+                return Err(format!(
+                    "unknown ablation {other:?}: expected full, no-vertex-color, no-vertex-opacity or no-backward"
+                ));
+            }
+        })
+    }
+}
+
+/// Schedule, weights and learning rates of the articulation phase.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ArticulationConfig {
+    pub iterations: u32,
+    /// Fraction of the phase at which the joint type is decided and the vertex-wise term starts.
+    pub decide_at: f32,
+    /// Fraction at which the backward pixel-wise term starts (the paper delays it).
+    pub backward_from: f32,
+    /// λ_PMC and λ_VMC (paper: 0.05 each).
+    pub pixel_weight: f64,
+    pub vertex_weight: f64,
+    /// The pixel-wise term's image loss.
+    pub weights: LossWeights,
+    /// Window sharpness γ and opacity floor of the articulation renders. Softer than the
+    /// reconstruction's final opaque, hard triangles: through those, moving a part changes which
+    /// pixels it covers only in jumps the gradient cannot see (φ = u^γ saturates the opacity
+    /// clamp), and the remaining colour-interpolation gradient drifts the motion away.
+    pub gamma: f32,
+    pub opacity_floor: f32,
+    pub vertex: VertexMotionWeights,
+    pub rates: MotionRates,
+    pub ablation: Ablation,
+    /// Loss terms are read back (and reported) every this many steps.
+    pub report_every: u32,
+    pub seed: u64,
+}
+
+impl ArticulationConfig {
+    /// The articulation settings of a preset (tiny 40, fast 300, paper 20 000 steps).
+    pub fn preset(preset: Preset) -> Self {
+        let (iterations, report_every) = match preset {
+            Preset::Tiny => (40, 5),
+            Preset::Fast => (300, 20),
+            Preset::Paper => (20_000, 200),
+        };
+        Self {
+            iterations,
+            decide_at: 0.5,
+            backward_from: 0.5,
+            pixel_weight: 0.05,
+            vertex_weight: 0.05,
+            // The reconstruction's image loss: besides the paper's L1 + SSIM, depth and the part
+            // labels say directly where a moved part belongs.
+            weights: LossWeights::default(),
+            gamma: 1.0,
+            opacity_floor: 0.0,
+            vertex: VertexMotionWeights::default(),
+            rates: MotionRates::default(),
+            ablation: Ablation::FULL,
+            report_every,
+            seed: 7,
+        }
+    }
+}
+
+/// The per-part joint-type decision.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct BakeOff {
+    /// Mean masked loss with the revolute / prismatic candidate (`None`: the part owns no
+    /// pixel in any state-t₂ view, and the registration residuals decided instead).
+    pub revolute_loss: Option<f64>,
+    pub prismatic_loss: Option<f64>,
+    /// Pixels of the part over all state-t₂ views.
+    pub pixels: usize,
+    pub kind: JointKind,
+}
+
+/// One movable part's fitted joint.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FittedJoint {
+    /// The part (1 ..= K).
+    pub part: usize,
+    pub kind: JointKind,
+    /// The fitted forward motion g⁺.
+    pub motion: PartMotion,
+    /// The joint in the ground-truth file's conventions.
+    pub joint: GtJoint,
+    /// The seeds, when the part was seen in both states.
+    pub initial: Option<JointCandidates>,
+    pub bake_off: BakeOff,
+}
+
+/// One reported point of the articulation curve.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct ArticulationPoint {
+    pub iteration: u32,
+    pub phase: Phase,
+    /// Forward pixel-wise loss of this step's view.
+    pub forward_loss: f32,
+    /// Backward pixel-wise loss, when on.
+    pub backward_loss: Option<f32>,
+    /// Vertex-wise loss (both directions), when on.
+    pub vertex_loss: Option<f64>,
+}
+
+/// Seconds per stage of the articulation phase.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct ArticulationTimes {
+    pub setup_s: f64,
+    pub candidates_s: f64,
+    pub bake_off_s: f64,
+    pub refine_s: f64,
+    pub total_s: f64,
+}
+
+/// The articulation field and how it was found.
+#[derive(Debug, Clone, Serialize)]
+pub struct Articulation {
+    pub config: ArticulationConfig,
+    /// One per movable part, in part order (part k ↔ joint k − 1).
+    pub joints: Vec<FittedJoint>,
+    /// The point revolute axis origins are reported closest to (the object's centre).
+    pub center: Vec3,
+    pub curve: Vec<ArticulationPoint>,
+    /// Things a user should know (a part unseen in one state, one that does not move).
+    pub warnings: Vec<String>,
+    pub times: ArticulationTimes,
+}
+
+impl Articulation {
+    /// The joints in `gt/trans.json` order.
+    pub fn gt_joints(&self) -> Vec<GtJoint> {
+        self.joints.iter().map(|j| j.joint).collect()
+    }
+}
+
+/// One state's frozen mesh, moved by the motions and rendered against the other state's views.
+struct MovedView<'a> {
+    field: GpuField,
+    moved: MovedMesh,
+    state: RasterState,
+    loss: ImageLoss,
+    targets: TargetImages,
+    frames: &'a [Frame],
+    cameras: Vec<Camera>,
+    order: Vec<usize>,
+}
+
+impl<'a> MovedView<'a> {
+    fn new(
+        ctx: &GpuContext,
+        kernels: &MotionKernels,
+        field: &MeshField,
+        parts: &[u32],
+        frames: &'a [Frame],
+    ) -> GpuResult<Self> {
+        let first = frames.first().ok_or_else(|| {
+            GpuError::InvalidInput("the articulation phase needs views of both states".into())
+        })?;
+        let (w, h) = (first.rgba.width, first.rgba.height);
+        let k = field.num_parts as u32;
+        let gpu = GpuField::upload(ctx, field)?;
+        let moved = MovedMesh::new(ctx, kernels, &gpu, &field.positions, parts)?;
+        let views: Vec<TargetView> = frames.iter().map(TargetView::from).collect();
+        Ok(Self {
+            state: RasterState::new(ctx, w, h, k)?,
+            loss: ImageLoss::new(ctx, w, h, k)?,
+            targets: TargetImages::upload(ctx, w, h, &views)?,
+            cameras: frames.iter().map(|f| f.camera).collect(),
+            field: gpu,
+            moved,
+            frames,
+            order: Vec::new(),
+        })
+    }
+
+    /// Renders the mesh moved by `motions` from the view of the shuffled cycle, back-propagates
+    /// the loss and reduces the position gradients: per-part sums (loss weight applied) and the
+    /// loss terms' buffer filled.
+    async fn step(
+        &mut self,
+        ctx: &GpuContext,
+        raster: &Rasterizer,
+        kernels: &MotionKernels,
+        motions: &[(DMat3, DVec3)],
+        settings: &RasterSettings,
+        weights: &LossWeights,
+        rng: &mut Rng,
+    ) -> GpuResult<Vec<PartSums>> {
+        if self.order.is_empty() {
+            self.order = (0..self.cameras.len()).collect();
+            for k in (1..self.order.len()).rev() {
+                self.order.swap(k, rng.below(k as u32 + 1) as usize);
+            }
+        }
+        let view = self.order.pop().unwrap_or(0);
+        self.gradient(ctx, raster, kernels, motions, view, settings, weights)
+            .await
+    }
+
+    /// The loss of view `view` with the mesh moved by `motions` (terms left in the loss's
+    /// buffer) and its per-part position-gradient sums.
+    #[allow(clippy::too_many_arguments)]
+    async fn gradient(
+        &mut self,
+        ctx: &GpuContext,
+        raster: &Rasterizer,
+        kernels: &MotionKernels,
+        motions: &[(DMat3, DVec3)],
+        view: usize,
+        settings: &RasterSettings,
+        weights: &LossWeights,
+    ) -> GpuResult<Vec<PartSums>> {
+        self.render(ctx, raster, kernels, motions, view, settings)
+            .await?;
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.loss.encode(
+            ctx,
+            &mut encoder,
+            self.state.render(),
+            &self.targets,
+            view,
+            weights,
+            settings.background.to_array(),
+            self.state.grad_render(),
+        )?;
+        raster.encode_backward(ctx, &mut encoder, &self.field, &mut self.state);
+        self.moved.encode_reduce(ctx, kernels, &mut encoder);
+        ctx.queue.submit([encoder.finish()]);
+        self.moved.read_sums(ctx).await
+    }
+
+    async fn render(
+        &mut self,
+        ctx: &GpuContext,
+        raster: &Rasterizer,
+        kernels: &MotionKernels,
+        motions: &[(DMat3, DVec3)],
+        view: usize,
+        settings: &RasterSettings,
+    ) -> GpuResult<()> {
+        let mut encoder = ctx.device.create_command_encoder(&Default::default());
+        self.moved
+            .encode_apply(ctx, kernels, &mut encoder, motions);
+        ctx.queue.submit([encoder.finish()]);
+        raster
+            .forward(ctx, &self.field, &mut self.state, &self.cameras[view], settings)
+            .await?;
+        Ok(())
+    }
+
+    /// The bake-off's loss of the mesh moved by `motions` on the pixels labelled `part` in
+    /// every view: Σ over those pixels of 0.8 |ΔRGB|₁/3 + 0.2 (1 − SSIM) + 0.5 |Δdepth| (the
+    /// image loss's weights), and the pixel count.
+    async fn masked_loss(
+        &mut self,
+        ctx: &GpuContext,
+        raster: &Rasterizer,
+        kernels: &MotionKernels,
+        motions: &[(DMat3, DVec3)],
+        part: usize,
+        settings: &RasterSettings,
+        weights: &LossWeights,
+    ) -> GpuResult<(f64, usize)> {
+        let (mut sum, mut pixels) = (0.0, 0);
+        for view in 0..self.cameras.len() {
+            let frame = &self.frames[view];
+            let Some(labels) = &frame.parts else {
+                continue;
+            };
+            let label = part as i16;
+            if !labels.ids.contains(&label) {
+                continue;
+            }
+            self.render(ctx, raster, kernels, motions, view, settings)
+                .await?;
+            let render = self.state.read_render(ctx).await?;
+            let (s, n) = masked_image_loss(&render.planes, frame, label, settings.background, weights);
+            sum += s;
+            pixels += n;
+        }
+        Ok((sum, pixels))
+    }
+}
+
+/// Σ over pixels labelled `label` (part id; −1 is background) of the per-pixel image loss (see [`MovedView::masked_loss`]).
+fn masked_image_loss(
+    planes: &[f32],
+    frame: &Frame,
+    label: i16,
+    background: Vec3,
+    weights: &LossWeights,
+) -> (f64, usize) {
+    let (w, h) = (frame.rgba.width as usize, frame.rgba.height as usize);
+    let n = w * h;
+    let target: Vec<[f64; 3]> = (0..n)
+        .map(|i| {
+            let px = &frame.rgba.pixels[4 * i..4 * i + 4];
+            let a = f64::from(px[3]) / 255.0;
+            [0, 1, 2].map(|c| f64::from(px[c]) / 255.0 * a + f64::from(background[c]) * (1.0 - a))
+        })
+        .collect();
+    let ssim = ssim_map(planes, &target, w, h);
+    let ids = frame.parts.as_ref().map(|p| &p.ids);
+    let (mut sum, mut count) = (0.0, 0);
+    for i in 0..n {
+        if ids.is_none_or(|ids| ids[i] != label) {
+            continue;
+        }
+        let l1 = (0..3)
+            .map(|c| (f64::from(planes[c * n + i]) - target[i][c]).abs())
+            .sum::<f64>()
+            / 3.0;
+        let mut loss = f64::from(weights.l1) * l1 + f64::from(weights.ssim) * (1.0 - ssim[i]);
+        if let Some(d) = frame.depth.as_ref().map(|d| d.millimetres[i]).filter(|&d| d > 0) {
+            loss += f64::from(weights.depth) * (f64::from(planes[3 * n + i]) - f64::from(d) / 1000.0).abs();
+        }
+        sum += loss;
+        count += 1;
+    }
+    (sum, count)
+}
+
+/// Per-pixel SSIM (mean over RGB) of the render's first three planes against `target`, with
+/// the image loss's 11-tap Gaussian window and zero padding.
+fn ssim_map(planes: &[f32], target: &[[f64; 3]], w: usize, h: usize) -> Vec<f64> {
+    let taps = ssim_taps();
+    let r = taps.len() / 2;
+    let blur = |img: &[f64]| -> Vec<f64> {
+        let mut tmp = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                tmp[y * w + x] = (0..taps.len())
+                    .filter_map(|t| {
+                        let xx = (x + t).checked_sub(r).filter(|&xx| xx < w)?;
+                        Some(taps[t] * img[y * w + xx])
+                    })
+                    .sum();
+            }
+        }
+        let mut out = vec![0.0; w * h];
+        for y in 0..h {
+            for x in 0..w {
+                out[y * w + x] = (0..taps.len())
+                    .filter_map(|t| {
+                        let yy = (y + t).checked_sub(r).filter(|&yy| yy < h)?;
+                        Some(taps[t] * tmp[yy * w + x])
+                    })
+                    .sum();
+            }
+        }
+        out
+    };
+    let n = w * h;
+    let mut total = vec![0.0; n];
+    for c in 0..3 {
+        let a: Vec<f64> = planes[c * n..(c + 1) * n].iter().map(|&v| f64::from(v)).collect();
+        let b: Vec<f64> = target.iter().map(|t| t[c]).collect();
+        let prod = |p: &[f64], q: &[f64]| -> Vec<f64> { p.iter().zip(q).map(|(x, y)| x * y).collect() };
+        let (ma, mb) = (blur(&a), blur(&b));
+        let (saa, sbb, sab) = (blur(&prod(&a, &a)), blur(&prod(&b, &b)), blur(&prod(&a, &b)));
+        for i in 0..n {
+            let (va, vb, cov) = (saa[i] - ma[i] * ma[i], sbb[i] - mb[i] * mb[i], sab[i] - ma[i] * mb[i]);
+            total[i] += (2.0 * ma[i] * mb[i] + SSIM_C1) * (2.0 * cov + SSIM_C2)
+                / ((ma[i] * ma[i] + mb[i] * mb[i] + SSIM_C1) * (va + vb + SSIM_C2))
+                / 3.0;
+        }
+    }
+    total
+}
+
+/// Vertices of `part` in a state's field.
+fn part_points(field: &MeshField, parts: &[u32], part: usize) -> Vec<Vec3> {
+    field
+        .positions
+        .iter()
+        .zip(parts)
+        .filter(|(_, p)| **p as usize == part)
+        .map(|(x, _)| *x)
+        .collect()
+}
+
+/// Per-part forward affine maps, part 0 (the static base) fixed.
+fn forward_maps(motions: &[PartMotion]) -> Vec<(DMat3, DVec3)> {
+    motions.iter().map(PartMotion::forward_affine).collect()
+}
+
+fn backward_maps(motions: &[PartMotion]) -> Vec<(DMat3, DVec3)> {
+    motions.iter().map(PartMotion::backward_affine).collect()
+}
+
+/// Rotations and translations below these count as "does not move".
+const STILL_ANGLE_DEG: f64 = 0.5;
+const STILL_DISTANCE_M: f64 = 0.002;
+
+/// Runs the articulation phase on a reconstruction of `dataset` (its two states' frozen meshes
+/// and training views).
+pub async fn articulate(
+    ctx: &GpuContext,
+    dataset: &Dataset,
+    rec: &Reconstruction,
+    config: &ArticulationConfig,
+    progress: &mut dyn FnMut(&Progress),
+) -> GpuResult<Articulation> {
+    let t0 = now_seconds();
+    let mut times = ArticulationTimes::default();
+    let mut warnings = Vec::new();
+    let (Some(s1), Some(s2)) = (
+        rec.states.iter().find(|s| s.state == State::Start),
+        rec.states.iter().find(|s| s.state == State::End),
+    ) else {
+        return Err(GpuError::InvalidInput(
+            "the articulation phase needs reconstructions of both states".into(),
+        ));
+    };
+    let k = rec.num_parts;
+    let views1 = training_views(dataset, State::Start, &rec.config).map_err(GpuError::InvalidInput)?;
+    let views2 = training_views(dataset, State::End, &rec.config).map_err(GpuError::InvalidInput)?;
+    let raster = Rasterizer::new(ctx);
+    let kernels = MotionKernels::new(ctx);
+    // Forward: state t₁'s mesh, moved by g⁺, against state t₂'s views; backward the reverse.
+    let mut forward = MovedView::new(ctx, &kernels, &s1.field, &s1.parts, &views2)?;
+    let mut backward = MovedView::new(ctx, &kernels, &s2.field, &s2.parts, &views1)?;
+    let surface1 = StateSurface::from_field(&s1.field).map_err(GpuError::InvalidInput)?;
+    let surface2 = StateSurface::from_field(&s2.field).map_err(GpuError::InvalidInput)?;
+    let recovery = rec.config.recovery();
+    let settings = RasterSettings {
+        gamma: config.gamma,
+        opacity_floor: config.opacity_floor,
+        ..recovery.settings_at(recovery.iterations)
+    };
+    let center = principal_frame(&s1.field.positions)
+        .map_or(DVec3::ZERO, |f| f.centroid);
+
+    // Seeds.
+    let mut candidates: Vec<Option<JointCandidates>> = vec![None; k];
+    for part in 1..k {
+        let a = part_points(&s1.field, &s1.parts, part);
+        let b = part_points(&s2.field, &s2.parts, part);
+        candidates[part] = initial_candidates(&a, &b);
+        if candidates[part].is_none() {
+            let missing = if a.len() < 3 { "start" } else { "end" };
+            warnings.push(format!(
+                "part {part} has no reconstructed surface in the {missing} state: its joint cannot be fitted and is reported as a motionless revolute joint"
+            ));
+        }
+    }
+    let pick = |f: fn(&JointCandidates) -> PartMotion| -> Vec<PartMotion> {
+        candidates
+            .iter()
+            .map(|c| c.as_ref().map_or(PartMotion::IDENTITY, f))
+            .collect()
+    };
+    let mut revolute = pick(|c| c.revolute);
+    let mut prismatic = pick(|c| c.prismatic);
+    let trainable: Vec<bool> = candidates.iter().map(Option::is_some).collect();
+    times.setup_s = now_seconds() - t0;
+
+    let n = config.iterations;
+    let decide = ((n as f32 * config.decide_at) as u32).min(n);
+    let backward_from = (n as f32 * config.backward_from) as u32;
+    let mut rng = Rng::new(config.seed);
+    let mut curve = Vec::new();
+    let event = |phase: Phase, iteration: u32, iterations: u32, loss: Option<f32>| Progress {
+        state: State::End,
+        phase,
+        iteration,
+        iterations,
+        loss,
+        psnr: None,
+        vertices: s1.field.num_vertices() + s2.field.num_vertices(),
+        faces: s1.field.faces.len() + s2.field.faces.len(),
+        elapsed_s: now_seconds() - t0,
+    };
+    progress(&event(Phase::Candidates, 0, decide, None));
+
+    // 1. Candidates, alternating.
+    let mut adam_rot = MotionAdam::new(k, config.rates);
+    let mut adam_trans = MotionAdam::new(k, config.rates);
+    let t_candidates = now_seconds();
+    for i in 0..decide {
+        let is_rot = i % 2 == 0;
+        let (motions, adam, kind) = if is_rot {
+            (&mut revolute, &mut adam_rot, JointKind::Revolute)
+        } else {
+            (&mut prismatic, &mut adam_trans, JointKind::Prismatic)
+        };
+        let sums_f = forward
+            .step(ctx, &raster, &kernels, &forward_maps(motions), &settings, &config.weights, &mut rng)
+            .await?;
+        let with_backward = config.ablation.backward && i >= backward_from;
+        let sums_b = if with_backward {
+            backward
+                .step(ctx, &raster, &kernels, &backward_maps(motions), &settings, &config.weights, &mut rng)
+                .await?
+        } else {
+            vec![PartSums::default(); k]
+        };
+        for part in (1..k).filter(|&p| trainable[p]) {
+            let g = motions[part].gradient(
+                &sums_f[part].scaled(config.pixel_weight),
+                &sums_b[part].scaled(config.pixel_weight),
+            );
+            adam.step(part, &mut motions[part], &g, MotionMask::of(kind));
+        }
+        if (i + 1) % config.report_every.max(1) == 0 || i + 1 == decide {
+            let terms = forward.loss.read_terms(ctx).await?;
+            curve.push(ArticulationPoint {
+                iteration: i,
+                phase: Phase::Candidates,
+                forward_loss: terms.total,
+                backward_loss: None,
+                vertex_loss: None,
+            });
+            progress(&event(Phase::Candidates, i + 1, decide, Some(terms.total)));
+        }
+    }
+    times.candidates_s = now_seconds() - t_candidates;
+
+    // 2. Bake-off.
+    let t_bake = now_seconds();
+    progress(&event(Phase::BakeOff, 0, (k - 1) as u32, None));
+    let mut kinds = vec![JointKind::Revolute; k];
+    let mut bake_offs = vec![
+        BakeOff {
+            revolute_loss: None,
+            prismatic_loss: None,
+            pixels: 0,
+            kind: JointKind::Revolute
+        };
+        k
+    ];
+    for part in (1..k).filter(|&p| trainable[p]) {
+        let only = |m: PartMotion| -> Vec<(DMat3, DVec3)> {
+            (0..k)
+                .map(|p| if p == part { m } else { PartMotion::IDENTITY }.forward_affine())
+                .collect()
+        };
+        let (rot, pixels) = forward
+            .masked_loss(ctx, &raster, &kernels, &only(revolute[part]), part, &settings, &config.weights)
+            .await?;
+        let (trans, _) = forward
+            .masked_loss(ctx, &raster, &kernels, &only(prismatic[part]), part, &settings, &config.weights)
+            .await?;
+        let c = candidates[part].as_ref().expect("trainable parts have candidates");
+        let kind = if pixels > 0 {
+            if rot <= trans { JointKind::Revolute } else { JointKind::Prismatic }
+        } else {
+            warnings.push(format!(
+                "part {part} owns no pixel in any end-state view: its joint type is decided by the registration residuals instead"
+            ));
+            if c.registration.residual <= c.prismatic_residual { JointKind::Revolute } else { JointKind::Prismatic }
+        };
+        kinds[part] = kind;
+        bake_offs[part] = BakeOff {
+            revolute_loss: (pixels > 0).then(|| rot / pixels as f64),
+            prismatic_loss: (pixels > 0).then(|| trans / pixels as f64),
+            pixels,
+            kind,
+        };
+        progress(&event(Phase::BakeOff, part as u32, (k - 1) as u32, None));
+    }
+    let mut motions: Vec<PartMotion> = (0..k)
+        .map(|p| match kinds[p] {
+            _ if !trainable[p] => PartMotion::IDENTITY,
+            JointKind::Revolute => revolute[p],
+            JointKind::Prismatic => prismatic[p],
+        })
+        .collect();
+    times.bake_off_s = now_seconds() - t_bake;
+
+    // 3. Refine the winners, fresh moments, type-masked.
+    let t_refine = now_seconds();
+    let mut adam = MotionAdam::new(k, config.rates);
+    let vertex = VertexMotionWeights {
+        color: if config.ablation.vertex_color { config.vertex.color } else { 0.0 },
+        opacity: if config.ablation.vertex_opacity { config.vertex.opacity } else { 0.0 },
+        ..config.vertex
+    };
+    let vertex_on = vertex.color > 0.0 || vertex.opacity > 0.0;
+    let refine = n - decide;
+    progress(&event(Phase::Refine, 0, refine, None));
+    for i in decide..n {
+        let sums_f = forward
+            .step(ctx, &raster, &kernels, &forward_maps(&motions), &settings, &config.weights, &mut rng)
+            .await?;
+        let with_backward = config.ablation.backward && i >= backward_from;
+        let sums_b = if with_backward {
+            backward
+                .step(ctx, &raster, &kernels, &backward_maps(&motions), &settings, &config.weights, &mut rng)
+                .await?
+        } else {
+            vec![PartSums::default(); k]
+        };
+        let mut vertex_loss = None;
+        let (mut vf, mut vb) = (vec![PartSums::default(); k], vec![PartSums::default(); k]);
+        if vertex_on {
+            let f = vertex_motion_loss(&surface1, &surface2, &forward_maps(&motions), &vertex)
+                .map_err(GpuError::InvalidInput)?;
+            let mut total = f.loss;
+            vf = f.per_part;
+            if config.ablation.backward {
+                let b = vertex_motion_loss(&surface2, &surface1, &backward_maps(&motions), &vertex)
+                    .map_err(GpuError::InvalidInput)?;
+                total += b.loss;
+                vb = b.per_part;
+            }
+            vertex_loss = Some(total);
+        }
+        for part in (1..k).filter(|&p| trainable[p]) {
+            let fw = sums_f[part]
+                .scaled(config.pixel_weight)
+                .merged(vf[part].scaled(config.vertex_weight));
+            let bw = sums_b[part]
+                .scaled(config.pixel_weight)
+                .merged(vb[part].scaled(config.vertex_weight));
+            let g = motions[part].gradient(&fw, &bw);
+            adam.step(part, &mut motions[part], &g, MotionMask::of(kinds[part]));
+        }
+        let step = i - decide;
+        if (step + 1) % config.report_every.max(1) == 0 || i + 1 == n {
+            let terms = forward.loss.read_terms(ctx).await?;
+            let backward_loss = if with_backward {
+                Some(backward.loss.read_terms(ctx).await?.total)
+            } else {
+                None
+            };
+            curve.push(ArticulationPoint {
+                iteration: i,
+                phase: Phase::Refine,
+                forward_loss: terms.total,
+                backward_loss,
+                vertex_loss,
+            });
+            progress(&event(Phase::Refine, step + 1, refine, Some(terms.total)));
+        }
+    }
+    times.refine_s = now_seconds() - t_refine;
+
+    let joints: Vec<FittedJoint> = (1..k)
+        .map(|part| {
+            let motion = motions[part];
+            FittedJoint {
+                part,
+                kind: kinds[part],
+                motion,
+                joint: motion.joint(kinds[part], center),
+                initial: candidates[part],
+                bake_off: bake_offs[part],
+            }
+        })
+        .collect();
+    for j in &joints {
+        let still = match j.kind {
+            JointKind::Revolute => f64::from(j.joint.motion().abs()) < STILL_ANGLE_DEG,
+            JointKind::Prismatic => f64::from(j.joint.motion().abs()) < STILL_DISTANCE_M,
+        };
+        if still && trainable[j.part] {
+            warnings.push(format!(
+                "part {} barely moves between the states ({:.3} {}): its axis and joint type are guesses",
+                j.part,
+                j.joint.motion(),
+                if j.kind == JointKind::Revolute { "°" } else { "m" }
+            ));
+        }
+    }
+    times.total_s = now_seconds() - t0;
+    progress(&event(Phase::Done, refine, refine, None));
+    Ok(Articulation {
+        config: *config,
+        joints,
+        center: center.as_vec3(),
+        curve,
+        warnings,
+        times,
+    })
+}
+
+
+/// TEMP exploration: full-batch forward loss and per-part parameter gradients at `motions`.
+pub async fn full_batch(
+    ctx: &GpuContext,
+    dataset: &Dataset,
+    rec: &Reconstruction,
+    motions: &[PartMotion],
+    weights: &LossWeights,
+    smooth: bool,
+) -> GpuResult<(f64, Vec<crate::articulation::MotionGradient>)> {
+    let k = rec.num_parts;
+    let views2 = training_views(dataset, State::End, &rec.config).map_err(GpuError::InvalidInput)?;
+    let s1 = &rec.states[0];
+    let raster = Rasterizer::new(ctx);
+    let kernels = MotionKernels::new(ctx);
+    let mut forward = MovedView::new(ctx, &kernels, &s1.field, &s1.parts, &views2)?;
+    let recovery = rec.config.recovery();
+    let mut settings = recovery.settings_at(recovery.iterations);
+    if smooth {
+        settings = RasterSettings { gamma: 1.0, opacity_floor: 0.0, ..settings }.smooth();
+    }
+    let mut total = 0.0;
+    let mut sums = vec![PartSums::default(); k];
+    for v in 0..views2.len() {
+        let s = forward.gradient(ctx, &raster, &kernels, &forward_maps(motions), v, &settings, weights).await?;
+        total += f64::from(forward.loss.read_terms(ctx).await?.total);
+        for (a, b) in sums.iter_mut().zip(s) {
+            *a = a.merged(b);
+        }
+    }
+    let zero = PartSums::default();
+    Ok((total, (0..k).map(|p| motions[p].gradient(&sums[p], &zero)).collect()))
+}

@@ -1,0 +1,159 @@
+//! The product's main job on one object: the reconstruction phase on both states, then the
+//! articulation phase on their frozen meshes, and the result in the dataset's own conventions
+//! (part meshes as a `gt/` folder, joints as `gt/trans.json`) plus a richer `joints.json`.
+
+use serde::Serialize;
+
+use super::articulate::{Articulation, ArticulationConfig, articulate};
+use super::reconstruct::{Preset, Progress, Reconstruction, ReconstructionConfig, reconstruct};
+use crate::data::{Dataset, GroundTruth, JointKind, State};
+use crate::eval::{EvalError, EvalOptions, ObjectMetrics, evaluate_object};
+use crate::gpu::{GpuContext, GpuResult};
+
+/// Settings of both phases.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct FitConfig {
+    pub reconstruction: ReconstructionConfig,
+    pub articulation: ArticulationConfig,
+}
+
+impl FitConfig {
+    /// Both phases' settings of a preset.
+    pub fn preset(preset: Preset) -> Self {
+        Self {
+            reconstruction: ReconstructionConfig::preset(preset),
+            articulation: ArticulationConfig::preset(preset),
+        }
+    }
+}
+
+/// A fitted articulated object.
+#[derive(Debug, Clone)]
+pub struct ObjectFit {
+    pub reconstruction: Reconstruction,
+    pub articulation: Articulation,
+}
+
+/// One joint as `joints.json` lists it: the joint in the ground-truth conventions plus what a
+/// simulator export needs (limits spanning both observed states).
+#[derive(Debug, Clone, Serialize)]
+pub struct JointRecord {
+    /// The movable part this joint moves (1 ..= K; part 0 is the static base).
+    pub part: usize,
+    #[serde(rename = "type")]
+    pub kind: JointKind,
+    /// A point on the axis (m); for revolute joints the one closest to the object's centre.
+    pub origin: [f32; 3],
+    /// Unit axis direction.
+    pub direction: [f32; 3],
+    /// Motion from the start to the end state: degrees (revolute) or metres (prismatic).
+    pub motion: f32,
+    /// Joint value at the start and end states (start 0).
+    pub limits: [f32; 2],
+    /// The bake-off's masked losses (revolute, prismatic).
+    pub bake_off: [Option<f64>; 2],
+}
+
+impl ObjectFit {
+    /// Predicted meshes and joints as a `gt/` folder (what `artmesh eval` reads).
+    pub fn as_ground_truth(&self) -> GroundTruth {
+        GroundTruth {
+            joints: Some(self.articulation.gt_joints()),
+            ..self.reconstruction.as_ground_truth()
+        }
+    }
+
+    /// The joints for `joints.json`.
+    pub fn joint_records(&self) -> Vec<JointRecord> {
+        self.articulation
+            .joints
+            .iter()
+            .map(|j| {
+                let motion = j.joint.motion();
+                JointRecord {
+                    part: j.part,
+                    kind: j.kind,
+                    origin: j.joint.origin.to_array(),
+                    direction: j.joint.unit_direction().to_array(),
+                    motion,
+                    limits: [motion.min(0.0), motion.max(0.0)],
+                    bake_off: [j.bake_off.revolute_loss, j.bake_off.prismatic_loss],
+                }
+            })
+            .collect()
+    }
+
+    /// Scores the fit against the dataset's ground truth (joints, and start-state meshes when
+    /// both sides have them); `None` without GT joints.
+    pub fn evaluate(
+        &self,
+        dataset: &Dataset,
+        id: &str,
+        category: &str,
+        options: &EvalOptions,
+    ) -> Option<Result<ObjectMetrics, EvalError>> {
+        let gt_joints = dataset.gt_joints.as_ref()?;
+        let predicted = self.as_ground_truth();
+        let state = State::Start.index();
+        let meshes = predicted.meshes[state]
+            .as_ref()
+            .zip(dataset.gt_meshes[state].as_ref());
+        Some(evaluate_object(
+            id,
+            category,
+            &self.articulation.gt_joints(),
+            gt_joints,
+            meshes,
+            options,
+        ))
+    }
+}
+
+/// Fits `dataset`: reconstruction of both states, then articulation; `progress` hears both.
+pub async fn fit_object(
+    ctx: &GpuContext,
+    dataset: &Dataset,
+    config: &FitConfig,
+    progress: &mut dyn FnMut(&Progress),
+) -> GpuResult<ObjectFit> {
+    let reconstruction = reconstruct(ctx, dataset, &config.reconstruction, progress).await?;
+    let articulation =
+        articulate(ctx, dataset, &reconstruction, &config.articulation, progress).await?;
+    Ok(ObjectFit {
+        reconstruction,
+        articulation,
+    })
+}
+
+/// A small procedural object (`category` with `movable_parts`, seed `seed`) captured at 32² with
+/// 4 views per state and fitted with the `tiny` preset: the fit the native and browser tests
+/// share. `edit` may change the dataset before the fit (to make odd data).
+pub async fn tiny_fit(
+    ctx: &GpuContext,
+    category: crate::synth::Category,
+    movable_parts: usize,
+    seed: u64,
+    spec_edit: &dyn Fn(&mut crate::render::RenderSpec),
+    edit: &dyn Fn(&mut Dataset),
+) -> Result<(Dataset, ObjectFit), String> {
+    let object = crate::synth::generate(&crate::synth::SynthParams {
+        category,
+        movable_parts: Some(movable_parts),
+        seed,
+    })?;
+    let mut spec = crate::render::RenderSpec {
+        width: 32,
+        height: 32,
+        train_views: 4,
+        test_views: 0,
+        seed,
+        ..crate::render::RenderSpec::default()
+    };
+    spec_edit(&mut spec);
+    let mut dataset = crate::render::capture_dataset(ctx, &object, &spec).await?;
+    edit(&mut dataset);
+    let fit = fit_object(ctx, &dataset, &FitConfig::preset(Preset::Tiny), &mut |_| {})
+        .await
+        .map_err(|e| e.to_string())?;
+    Ok((dataset, fit))
+}
