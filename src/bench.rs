@@ -424,6 +424,27 @@ pub struct CaptureSettings {
     pub train_views: usize,
 }
 
+/// A suite entry's object captured in memory at `size`² with `views` training views per state.
+fn capture_entry(
+    ctx: &GpuContext,
+    entry: &crate::synth::SuiteEntry,
+    size: u32,
+    views: usize,
+) -> Result<crate::data::Dataset, String> {
+    let id = entry.id();
+    let object = crate::synth::generate(&entry.params()).map_err(|e| format!("{id}: {e}"))?;
+    let spec = crate::render::RenderSpec {
+        width: size,
+        height: size,
+        train_views: views,
+        test_views: 0,
+        seed: entry.seed,
+        ..crate::render::RenderSpec::default()
+    };
+    pollster::block_on(crate::render::capture_dataset(ctx, &object, &spec))
+        .map_err(|e| format!("{id}: {e}"))
+}
+
 /// Reconstructs the quick-suite objects (all, or those whose id contains one of `only`), each
 /// captured in memory at `size`² with `views` training views per state, and times every phase.
 pub fn reconstruct(
@@ -434,8 +455,7 @@ pub fn reconstruct(
     views: usize,
     log: &mut dyn FnMut(&ReconstructObject),
 ) -> Result<ReconstructBench, String> {
-    use crate::render::{RenderSpec, capture_dataset};
-    use crate::synth::{generate, suite_plan};
+    use crate::synth::suite_plan;
     let mut objects = Vec::new();
     let mut totals = PhaseTotals::default();
     for entry in suite_plan(true) {
@@ -443,17 +463,7 @@ pub fn reconstruct(
         if !only.is_empty() && !only.iter().any(|o| id.contains(o.as_str())) {
             continue;
         }
-        let object = generate(&entry.params()).map_err(|e| format!("{id}: {e}"))?;
-        let spec = RenderSpec {
-            width: size,
-            height: size,
-            train_views: views,
-            test_views: 0,
-            seed: entry.seed,
-            ..RenderSpec::default()
-        };
-        let dataset = pollster::block_on(capture_dataset(ctx, &object, &spec))
-            .map_err(|e| format!("{id}: {e}"))?;
+        let dataset = capture_entry(ctx, &entry, size, views)?;
         let start = Instant::now();
         let reconstruction = pollster::block_on(crate::fit::reconstruct::reconstruct(
             ctx,
@@ -576,8 +586,7 @@ pub fn fit(
     use crate::fit::articulate::{Ablation, articulate};
     use crate::fit::object::ObjectFit;
     use crate::fit::reconstruct::{RemeshMode, reconstruct};
-    use crate::render::{RenderSpec, capture_dataset};
-    use crate::synth::{generate, suite_plan};
+    use crate::synth::suite_plan;
     let started = Instant::now();
     let options = EvalOptions::default();
     let mut objects = Vec::new();
@@ -595,17 +604,7 @@ pub fn fit(
             continue;
         }
         let named = |e: String| format!("{id}: {e}");
-        let object = generate(&entry.params()).map_err(named)?;
-        let spec = RenderSpec {
-            width: size,
-            height: size,
-            train_views: views,
-            test_views: 0,
-            seed: entry.seed,
-            ..RenderSpec::default()
-        };
-        let dataset = pollster::block_on(capture_dataset(ctx, &object, &spec))
-            .map_err(|e| named(e.to_string()))?;
+        let dataset = capture_entry(ctx, &entry, size, views)?;
         let score = |fit: &ObjectFit| -> Result<crate::eval::ObjectMetrics, String> {
             fit.evaluate(&dataset, &id, entry.category, &options)
                 .ok_or_else(|| named("the captured object has no ground-truth joints".into()))?
@@ -686,7 +685,10 @@ pub fn fit(
                     .map(|r| format!(
                         "{} {:.2}",
                         r.name,
-                        r.objects.last().and_then(|m| m.axis_ang).unwrap_or(f64::NAN)
+                        r.objects
+                            .last()
+                            .and_then(|m| m.axis_ang)
+                            .unwrap_or(f64::NAN)
                     ))
                     .collect::<Vec<_>>()
                     .join(", ")

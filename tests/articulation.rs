@@ -24,15 +24,8 @@ fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
         (Category::Laptop, 1005, JointKind::Revolute),
         (Category::Pen, 1007, JointKind::Prismatic),
     ] {
-        let (dataset, fit) = pollster::block_on(tiny_fit(
-            &ctx,
-            category,
-            1,
-            seed,
-            &no_spec_edit,
-            &no_edit,
-        ))
-        .unwrap();
+        let (dataset, fit) =
+            pollster::block_on(tiny_fit(&ctx, category, 1, seed, &no_spec_edit, &no_edit)).unwrap();
         let joint = &fit.articulation.joints[0];
         println!("{category:?}: {joint:#?}");
         assert_eq!(joint.kind, want, "{:?}", joint.bake_off);
@@ -73,7 +66,10 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
     .unwrap();
     println!("still: {:?}", fit.articulation.warnings);
     assert!(
-        fit.articulation.warnings.iter().any(|w| w.contains("barely moves")),
+        fit.articulation
+            .warnings
+            .iter()
+            .any(|w| w.contains("barely moves")),
         "{:?} {:?}",
         fit.articulation.warnings,
         fit.articulation.joints[0].joint
@@ -133,4 +129,3 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
     println!("no depth: {err}");
     assert!(err.contains("depth") && err.contains("end"), "{err}");
 }
-

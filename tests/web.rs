@@ -250,3 +250,43 @@ async fn a_tiny_reconstruction_runs_in_the_browser() {
     let failures = reconstruction_failures(&report, 25.0, 14.0);
     assert!(failures.is_empty(), "{failures:#?}");
 }
+
+#[wasm_bindgen_test]
+async fn motion_kernels_match_the_cpu_in_the_browser() {
+    let ctx = context().await;
+    artmesh::articulation::kernels::check_against_cpu(&ctx)
+        .await
+        .unwrap();
+}
+
+#[wasm_bindgen_test]
+async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
+    use artmesh::data::JointKind;
+    use artmesh::eval::EvalOptions;
+    use artmesh::fit::object::tiny_fit;
+    let ctx = context().await;
+    let (dataset, fit) = tiny_fit(
+        &ctx,
+        artmesh::synth::Category::Laptop,
+        1,
+        1005,
+        &|_| {},
+        &|_| {},
+    )
+    .await
+    .unwrap();
+    let metrics = fit
+        .evaluate(&dataset, "tiny", "Laptop", &EvalOptions::default())
+        .unwrap()
+        .unwrap();
+    console_log!(
+        "tiny fit: joint {:?}, Axis Ang {:?}, Axis Pos {:?}, Part Motion {:?}, {:.1} s articulation",
+        fit.articulation.joints[0].joint,
+        metrics.axis_ang,
+        metrics.axis_pos,
+        metrics.part_motion,
+        fit.articulation.times.total_s
+    );
+    assert_eq!(fit.articulation.joints[0].kind, JointKind::Revolute);
+    assert!(metrics.axis_ang.unwrap() < 10.0, "{metrics:?}");
+}

@@ -39,16 +39,15 @@ pub fn symmetric_eigen<const N: usize>(mut a: [[f64; N]; N]) -> ([f64; N], [[f64
                 let t = if theta == 0.0 { 1.0 } else { t };
                 let c = 1.0 / (t * t + 1.0).sqrt();
                 let s = t * c;
-                for k in 0..N {
-                    let (akp, akq) = (a[k][p], a[k][q]);
-                    a[k][p] = c * akp - s * akq;
-                    a[k][q] = s * akp + c * akq;
+                // A ← Jᵀ A J: columns p, q, then rows p, q.
+                for row in a.iter_mut() {
+                    let (akp, akq) = (row[p], row[q]);
+                    row[p] = c * akp - s * akq;
+                    row[q] = s * akp + c * akq;
                 }
-                for k in 0..N {
-                    let (apk, aqk) = (a[p][k], a[q][k]);
-                    a[p][k] = c * apk - s * aqk;
-                    a[q][k] = s * apk + c * aqk;
-                }
+                let (rp, rq) = (a[p], a[q]);
+                a[p] = std::array::from_fn(|k| c * rp[k] - s * rq[k]);
+                a[q] = std::array::from_fn(|k| s * rp[k] + c * rq[k]);
                 for row in v.iter_mut() {
                     let (vkp, vkq) = (row[p], row[q]);
                     row[p] = c * vkp - s * vkq;
@@ -196,6 +195,17 @@ pub struct JointCandidates {
     pub registration: Registration,
     /// Translation-only registration residual (m), next to `registration.residual`.
     pub prismatic_residual: f64,
+    /// Residual (m) of not moving at all.
+    pub identity_residual: f64,
+}
+
+impl JointCandidates {
+    /// Whether staying put fits about as well as the best registration: the part's motion is
+    /// below what the two reconstructions resolve.
+    pub fn barely_moves(&self) -> bool {
+        let best = self.registration.residual.min(self.prismatic_residual);
+        self.identity_residual <= 1.25 * best + SAME_FIT
+    }
 }
 
 /// Rotations below this (radians) leave the axis to PCA: the registration cannot resolve it.
@@ -248,16 +258,22 @@ pub fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCandidate
                 .1
                 .total_cmp(&rotation_axis_angle(b.rotation).1)
         })?;
-    let slide = icp(
-        start,
-        &tree,
-        Registration {
+    // The slide starts from the centroid shift and from where the rigid registration moves the
+    // centroid (the centroids disagree when one state shows more of the part, e.g. a drawer's sides).
+    let slide = [
+        f2.centroid - f1.centroid,
+        registration.apply(f1.centroid) - f1.centroid,
+    ]
+    .into_iter()
+    .map(|translation| {
+        let reg = Registration {
             rotation: DQuat::IDENTITY,
-            translation: f2.centroid - f1.centroid,
+            translation,
             residual: 0.0,
-        },
-        false,
-    );
+        };
+        icp(start, &tree, reg, false)
+    })
+    .min_by(|a, b| a.residual.total_cmp(&b.residual))?;
 
     let (axis, angle) = rotation_axis_angle(registration.rotation);
     let radius = start
@@ -292,6 +308,16 @@ pub fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCandidate
         prismatic: PartMotion::prismatic(slide.translation),
         registration,
         prismatic_residual: slide.residual,
+        identity_residual: matches(
+            start,
+            &tree,
+            &Registration {
+                rotation: DQuat::IDENTITY,
+                translation: DVec3::ZERO,
+                residual: 0.0,
+            },
+        )
+        .0,
     })
 }
 
@@ -362,6 +388,9 @@ mod tests {
             c.prismatic.translation
         );
         assert!(c.prismatic_residual < 0.02);
+        assert!(!c.barely_moves());
+        let still = initial_candidates(&start, &slab(&mut rng)).unwrap();
+        assert!(still.barely_moves(), "{still:?}");
     }
 
     #[test]

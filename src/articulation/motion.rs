@@ -268,6 +268,8 @@ pub struct MotionAdam {
     m: Vec<[f64; 10]>,
     v: Vec<[f64; 10]>,
     steps: Vec<u32>,
+    /// Multiplies every rate (1 = the configured rates).
+    scale: f64,
 }
 
 const BETA1: f64 = 0.9;
@@ -282,7 +284,13 @@ impl MotionAdam {
             m: vec![[0.0; 10]; parts],
             v: vec![[0.0; 10]; parts],
             steps: vec![0; parts],
+            scale: 1.0,
         }
+    }
+
+    /// Scales every learning rate to `factor` × the initial ones (a decay schedule).
+    pub fn set_scale(&mut self, factor: f64) {
+        self.scale = factor;
     }
 
     /// Zeroes part `k`'s moments (after the joint-type decision).
@@ -331,7 +339,7 @@ impl MotionAdam {
             let (m, v) = (&mut self.m[k][i], &mut self.v[k][i]);
             *m = BETA1 * *m + (1.0 - BETA1) * grads[i];
             *v = BETA2 * *v + (1.0 - BETA2) * grads[i] * grads[i];
-            delta[i] = -lr * (*m / c1) / ((*v / c2).sqrt() + EPSILON);
+            delta[i] = -lr * self.scale * (*m / c1) / ((*v / c2).sqrt() + EPSILON);
         }
         let q = motion.rotation;
         motion.rotation = DQuat::from_xyzw(

@@ -258,6 +258,23 @@ mod cli {
     }
 
     /// How objects are captured (defaults: the paper's Articulate-100 setting).
+    /// Which suite objects a benchmark fits, and how they are captured.
+    #[derive(clap::Args)]
+    struct SuiteObjects {
+        /// Preset: tiny, fast or paper.
+        #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
+        preset: String,
+        /// Only objects whose id contains one of these (e.g. laptop,oven); default all.
+        #[arg(long, value_delimiter = ',')]
+        objects: Vec<String>,
+        /// Square capture size (the quick suite's is 64).
+        #[arg(long, default_value_t = 64)]
+        size: u32,
+        /// Training views per state (the quick suite's is 6).
+        #[arg(long, default_value_t = 6)]
+        views: usize,
+    }
+
     #[derive(clap::Args)]
     struct CaptureArgs {
         /// Image width in pixels [default: 800; 64 with --quick].
@@ -335,18 +352,8 @@ mod cli {
         /// phase and state, mesh quality per part (pieces, boundary/non-manifold edges, cross-part
         /// faces, Chamfer to ground truth). Progress per object on stderr.
         Reconstruct {
-            /// Preset: tiny, fast or paper.
-            #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
-            preset: String,
-            /// Only objects whose id contains one of these (e.g. laptop,oven); default all 16.
-            #[arg(long, value_delimiter = ',')]
-            objects: Vec<String>,
-            /// Square capture size (the quick suite's is 64).
-            #[arg(long, default_value_t = 64)]
-            size: u32,
-            /// Training views per state (the quick suite's is 6).
-            #[arg(long, default_value_t = 6)]
-            views: usize,
+            #[command(flatten)]
+            suite: SuiteObjects,
             /// part-aware or global remeshing.
             #[arg(long, default_value = "part-aware", value_parser = ["part-aware", "global"])]
             remesh: String,
@@ -357,20 +364,10 @@ mod cli {
         /// paper's Table 4.
         Fit {
             /// quick (16 objects, one per category) or full (100 objects).
-            #[arg(long, default_value = "quick", value_parser = ["quick", "full"])]
-            suite: String,
-            /// Preset: tiny, fast or paper.
-            #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
-            preset: String,
-            /// Only objects whose id contains one of these (e.g. laptop,oven).
-            #[arg(long, value_delimiter = ',')]
-            objects: Vec<String>,
-            /// Square capture size.
-            #[arg(long, default_value_t = 64)]
-            size: u32,
-            /// Training views per state.
-            #[arg(long, default_value_t = 6)]
-            views: usize,
+            #[arg(long = "suite", default_value = "quick", value_parser = ["quick", "full"])]
+            which: String,
+            #[command(flatten)]
+            suite: SuiteObjects,
             /// Override the preset's articulation steps.
             #[arg(long)]
             articulation_iterations: Option<u32>,
@@ -569,9 +566,8 @@ mod cli {
                 }
                 capture::fresh_folder(&out)?;
                 let files = data::read_dir(&root).map_err(|e| e.to_string())?;
-                let dataset = Dataset::from_files(&files).map_err(|e| {
-                    format!("{}: {} problem(s):\n{e}", root.display(), e.0.len())
-                })?;
+                let dataset = Dataset::from_files(&files)
+                    .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))?;
                 let id = root
                     .file_name()
                     .map_or("object".into(), |n| n.to_string_lossy().into_owned());
@@ -629,10 +625,18 @@ mod cli {
                         .map_err(|e| format!("{}: {e}", object.name))?;
                 let files = dataset.to_files().map_err(|e| e.to_string())?;
                 data::write_dir(&files, &out.join("dataset")).map_err(|e| e.to_string())?;
-                let report =
-                    fit_and_write(&dataset, &config, &out.join("fit"), &object.name, category.name())?;
+                let report = fit_and_write(
+                    &dataset,
+                    &config,
+                    &out.join("fit"),
+                    &object.name,
+                    category.name(),
+                )?;
                 out!("{}", to_json(&report)?);
-                eprintln!("demo: dataset in {0}/dataset, fit in {0}/fit", out.display());
+                eprintln!(
+                    "demo: dataset in {0}/dataset, fit in {0}/fit",
+                    out.display()
+                );
                 Ok(ExitCode::SUCCESS)
             }
             Command::Reconstruct {
@@ -704,11 +708,14 @@ mod cli {
             Command::Bench {
                 which:
                     Bench::Fit {
-                        suite,
-                        preset,
-                        objects,
-                        size,
-                        views,
+                        which,
+                        suite:
+                            SuiteObjects {
+                                preset,
+                                objects,
+                                size,
+                                views,
+                            },
                         articulation_iterations,
                         ablations,
                         markdown,
@@ -725,7 +732,7 @@ mod cli {
                 let report = artmesh::bench::fit(
                     &ctx,
                     &config,
-                    suite == "quick",
+                    which == "quick",
                     &objects,
                     size,
                     views,
@@ -792,10 +799,13 @@ mod cli {
             Command::Bench {
                 which:
                     Bench::Reconstruct {
-                        preset,
-                        objects,
-                        size,
-                        views,
+                        suite:
+                            SuiteObjects {
+                                preset,
+                                objects,
+                                size,
+                                views,
+                            },
                         remesh,
                     },
             } => {
@@ -893,7 +903,11 @@ mod cli {
             eprintln!("fit: warning: {w}");
         }
         for j in &joints {
-            let unit = if j.kind == data::JointKind::Revolute { "°" } else { " m" };
+            let unit = if j.kind == data::JointKind::Revolute {
+                "°"
+            } else {
+                " m"
+            };
             eprintln!(
                 "fit: part {}: {:?} joint, axis {:.3?} through {:.3?}, motion {:.3}{unit} (bake-off losses {:.4?})",
                 j.part, j.kind, j.direction, j.origin, j.motion, j.bake_off
@@ -944,7 +958,9 @@ mod cli {
     /// Both phases' settings of the named preset.
     fn fit_config(preset: &str) -> Result<artmesh::fit::object::FitConfig, String> {
         use artmesh::fit::reconstruct::Preset;
-        Ok(artmesh::fit::object::FitConfig::preset(Preset::parse(preset)?))
+        Ok(artmesh::fit::object::FitConfig::preset(Preset::parse(
+            preset,
+        )?))
     }
 
     /// The named preset with the named remeshing mode (`part-aware` or `global`).

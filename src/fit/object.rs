@@ -117,8 +117,14 @@ pub async fn fit_object(
     progress: &mut dyn FnMut(&Progress),
 ) -> GpuResult<ObjectFit> {
     let reconstruction = reconstruct(ctx, dataset, &config.reconstruction, progress).await?;
-    let articulation =
-        articulate(ctx, dataset, &reconstruction, &config.articulation, progress).await?;
+    let articulation = articulate(
+        ctx,
+        dataset,
+        &reconstruction,
+        &config.articulation,
+        progress,
+    )
+    .await?;
     Ok(ObjectFit {
         reconstruction,
         articulation,

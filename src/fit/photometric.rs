@@ -226,6 +226,33 @@ fn target_rgb(frame: &Frame, background: Vec3) -> Vec<f32> {
     out
 }
 
+/// Records the image loss of `state`'s last render against target view `view` and the
+/// rasterizer's backward pass, which leaves the gradients in `field`'s gradient buffers.
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn encode_loss_and_backward(
+    ctx: &GpuContext,
+    encoder: &mut wgpu::CommandEncoder,
+    raster: &Rasterizer,
+    (loss, targets, view): (&ImageLoss, &TargetImages, usize),
+    state: &mut RasterState,
+    field: &GpuField,
+    weights: &LossWeights,
+    settings: &RasterSettings,
+) -> GpuResult<()> {
+    loss.encode(
+        ctx,
+        encoder,
+        state.render(),
+        targets,
+        view,
+        weights,
+        settings.background.to_array(),
+        state.grad_render(),
+    )?;
+    raster.encode_backward(ctx, encoder, field, state);
+    Ok(())
+}
+
 /// The photometric training state of one mesh field against one set of posed views: the
 /// rasterizer, the image loss with its uploaded targets, the field on the GPU and its Adam. The
 /// photometric fit and the reconstruction phase both step it; the reconstruction also edits the
@@ -313,18 +340,16 @@ impl<'a> Trainer<'a> {
             )
             .await?;
         let mut encoder = ctx.device.create_command_encoder(&Default::default());
-        self.loss.encode(
+        encode_loss_and_backward(
             ctx,
             &mut encoder,
-            self.state.render(),
-            &self.targets,
-            view,
+            &self.raster,
+            (&self.loss, &self.targets, view),
+            &mut self.state,
+            &self.field,
             weights,
-            settings.background.to_array(),
-            self.state.grad_render(),
+            settings,
         )?;
-        self.raster
-            .encode_backward(ctx, &mut encoder, &self.field, &mut self.state);
         self.optimizer.encode_step(ctx, &mut encoder)?;
         ctx.queue.submit([encoder.finish()]);
         Ok(())

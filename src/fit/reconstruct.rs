@@ -281,6 +281,11 @@ pub enum Phase {
 }
 
 impl Phase {
+    /// Whether this is a stage of the articulation phase (both states at once).
+    pub fn is_articulation(self) -> bool {
+        matches!(self, Phase::Candidates | Phase::BakeOff | Phase::Refine)
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Phase::Initialise => "initialise",

@@ -29,7 +29,10 @@ pub fn fresh_folder(out: &Path) -> Result<(), String> {
 /// Refuses an existing file: outputs never overwrite the user's files.
 pub fn fresh_file(path: &Path) -> Result<(), String> {
     if path.exists() {
-        return Err(format!("{} already exists; choose a new file", path.display()));
+        return Err(format!(
+            "{} already exists; choose a new file",
+            path.display()
+        ));
     }
     Ok(())
 }

@@ -10,6 +10,8 @@ pub struct Bar {
     label: &'static str,
     terminal: bool,
     last: Option<(Phase, u32)>,
+    /// When the current phase began (for its ETA).
+    phase_start: Option<(Phase, std::time::Instant)>,
 }
 
 impl Bar {
@@ -18,6 +20,7 @@ impl Bar {
             label,
             terminal: std::io::stderr().is_terminal(),
             last: None,
+            phase_start: None,
         }
     }
 
@@ -28,6 +31,16 @@ impl Bar {
             1.0
         };
         let tenth = (fraction * 10.0) as u32;
+        if self.phase_start.is_none_or(|(phase, _)| phase != p.phase) {
+            self.phase_start = Some((p.phase, std::time::Instant::now()));
+        }
+        // The phase's remaining time at its pace so far.
+        let eta = self
+            .phase_start
+            .map(|(_, t)| t.elapsed().as_secs_f32())
+            .filter(|_| fraction > 0.02 && fraction < 1.0)
+            .map(|spent| format!("  ETA {:.0} s", spent * (1.0 - fraction) / fraction))
+            .unwrap_or_default();
         let changed = self
             .last
             .is_none_or(|(phase, t)| phase != p.phase || t != tenth);
@@ -46,9 +59,14 @@ impl Bar {
         let loss = p.loss.map(|l| format!("  loss {l:.4}")).unwrap_or_default();
         let psnr = p.psnr.map(|v| format!("  {v:.2} dB")).unwrap_or_default();
         let line = format!(
-            "{}: {:<5} {:<10} [{bar}]{steps}{loss}{psnr}  {} faces  {:.0} s",
+            "{}: {:<6} {:<10} [{bar}]{steps}{loss}{psnr}  {} faces  {:.0} s{eta}",
             self.label,
-            p.state.name(),
+            // The articulation phase works on both states at once.
+            if p.phase.is_articulation() {
+                "joints"
+            } else {
+                p.state.name()
+            },
             p.phase.name(),
             p.faces,
             p.elapsed_s
