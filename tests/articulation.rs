@@ -1,5 +1,6 @@
 //! The articulation phase on lavapipe: the motion kernels against the CPU, and the joint-type
 //! bake-off and whole phase on small procedural objects.
+#![cfg(not(target_arch = "wasm32"))]
 
 mod common;
 
