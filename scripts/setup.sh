@@ -18,6 +18,9 @@ command -v chromium >/dev/null 2>&1 || need_apt+=(chromium)
 command -v chromedriver >/dev/null 2>&1 || need_apt+=(chromium-driver)
 command -v node >/dev/null 2>&1 || need_apt+=(nodejs)
 command -v npm >/dev/null 2>&1 || need_apt+=(npm)
+# the simulator check (tests/sim) needs a Python with venv + ensurepip; Debian splits them into python3-venv
+command -v python3 >/dev/null 2>&1 || need_apt+=(python3)
+python3 -c 'import venv, ensurepip' >/dev/null 2>&1 || need_apt+=(python3-venv)
 fi
 if [ ${#need_apt[@]} -gt 0 ]; then
   echo "setup: installing apt packages: ${need_apt[*]}"
@@ -43,5 +46,29 @@ if [ -n "$want" ]; then
     echo "setup: installing wasm-bindgen-cli $want (found '${have:-none}')"
     cargo install -q wasm-bindgen-cli --version "$want" --force
   fi
+fi
+
+# npm packages of web/ (package-lock.json): playwright-core for the page test, gltf-validator for the
+# export tests.
+if [ ! -d web/node_modules/playwright-core ] || [ ! -d web/node_modules/gltf-validator ]; then
+  echo "setup: installing web/ npm packages"
+  (cd web && npm ci --no-audit --no-fund --loglevel=error)
+fi
+
+# MuJoCo and PyBullet for tests/sim/check_urdf.py, pinned, in a venv under the git-ignored target/.
+pyenv=target/pyenv
+pins=(mujoco==4.0.0 pybullet==3.2.7)
+pins_ok() {
+  "$pyenv/bin/python" - "${pins[@]}" >/dev/null 2>&1 <<'PY'
+import sys, importlib.metadata as md
+import mujoco, pybullet  # noqa: F401  (imports must work, not just the metadata)
+sys.exit(any(md.version(n) != v for n, v in (p.split("==") for p in sys.argv[1:])))
+PY
+}
+if ! pins_ok; then
+  echo "setup: installing ${pins[*]} into $pyenv"
+  "$pyenv/bin/python" -c '' >/dev/null 2>&1 || python3 -m venv --clear "$pyenv"
+  "$pyenv/bin/python" -m pip install -q --disable-pip-version-check "${pins[@]}"
+  pins_ok || { echo "setup: $pyenv cannot import mujoco and pybullet" >&2; exit 1; }
 fi
 echo "setup: ok"

@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The project's one test command (README; .ci/run calls exactly this). On a fresh Debian machine
-# with only rustup it installs what it needs (scripts/setup.sh), then runs: formatting, clippy
-# for both targets, native tests on the Vulkan backend (lavapipe when no GPU), the wasm build,
+# with only rustup it installs what it needs (scripts/setup.sh: apt packages, the wasm target,
+# wasm-bindgen-cli, web/'s npm packages, a venv with MuJoCo and PyBullet), then runs: formatting,
+# clippy for both targets, native tests on the Vulkan backend (lavapipe when no GPU), the wasm build,
 # the wasm-bindgen browser tests and the page's end-to-end test in headless Chromium (WebGPU).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -38,6 +39,6 @@ export WASM_BINDGEN_TEST_TIMEOUT=${WASM_BINDGEN_TEST_TIMEOUT:-900}
 cargo test --target wasm32-unknown-unknown --test web
 
 step "page end-to-end test (playwright-core + Debian Chromium)"
-(cd web && { [ -d node_modules/playwright-core ] || npm ci --no-audit --no-fund --loglevel=error; } && node test/page.mjs)
+(cd web && node test/page.mjs)
 
 step "all tests passed"

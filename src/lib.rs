@@ -8,6 +8,7 @@
 pub mod articulation;
 pub mod data;
 pub mod eval;
+pub mod export;
 pub mod fit;
 pub mod gpu;
 pub mod loss;

@@ -434,3 +434,84 @@ fn reconstruct_writes_part_meshes_and_a_report_and_refuses_bad_input() {
     assert!(bench["phases"]["seconds"]["optimise_s"].as_f64().unwrap() > 0.0);
     assert!(bench["phases"]["dominant"].is_string());
 }
+
+/// `demo` ends with the twin's exports in its fit folder; `export` writes them again from that
+/// folder (the same node tree, the same archive entries), refuses to overwrite, and names what is
+/// missing.
+#[test]
+fn demo_writes_the_twin_and_export_rewrites_it() {
+    let tmp = TempDir::new("export");
+    let demo = tmp.join("demo");
+    let out = artmesh(&["demo", "--preset", "tiny", "--out", &demo]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let fit = format!("{demo}/fit");
+    for f in ["joints.json", "urdf/twin.urdf", "twin.glb", "twin.zip"] {
+        assert!(Path::new(&fit).join(f).is_file(), "{f} missing");
+    }
+    let joints: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(format!("{fit}/joints.json")).unwrap()).unwrap();
+    assert_eq!(joints[0]["joint"], "joint_1");
+    assert_eq!(
+        joints[0]["end_transform"][3],
+        serde_json::json!([0.0, 0.0, 0.0, 1.0])
+    );
+
+    let (glb, zip) = (tmp.join("again.glb"), tmp.join("again.zip"));
+    let out = artmesh(&["export", &fit, "--glb", &glb, "--urdf-zip", &zip]);
+    assert!(out.status.success(), "{}", text(&out.stderr));
+    let names = |bytes: Vec<u8>| {
+        let doc = gltf::Gltf::from_slice(&bytes).unwrap().document;
+        let mut n: Vec<(String, usize)> = doc
+            .nodes()
+            .map(|n| {
+                (
+                    n.name().unwrap_or_default().to_string(),
+                    n.children().count(),
+                )
+            })
+            .collect();
+        n.sort();
+        n
+    };
+    let original = names(std::fs::read(format!("{fit}/twin.glb")).unwrap());
+    assert_eq!(names(std::fs::read(&glb).unwrap()), original);
+    assert_eq!(original[0], ("base".to_string(), 2));
+    let entries = |path: &str| {
+        let mut z = zip::ZipArchive::new(std::fs::File::open(path).unwrap()).unwrap();
+        let mut n: Vec<String> = z.file_names().map(|f| f.unwrap().to_string()).collect();
+        n.sort();
+        let mut urdf = String::new();
+        let urdf_name = n.iter().find(|f| f.ends_with("twin.urdf")).unwrap().clone();
+        std::io::Read::read_to_string(&mut z.by_name(&urdf_name).unwrap(), &mut urdf).unwrap();
+        (n, urdf.contains("<limit lower="))
+    };
+    let (want, limits) = entries(&format!("{fit}/twin.zip"));
+    assert!(limits);
+    assert_eq!(entries(&zip).0, want);
+    assert!(
+        want.iter().any(|f| f.ends_with("/joints.json"))
+            && want.iter().any(|f| f.ends_with(".stl"))
+    );
+
+    let again = artmesh(&["export", &fit, "--glb", &glb]);
+    assert_eq!(again.status.code(), Some(1));
+    assert!(
+        text(&again.stderr).contains("already exists"),
+        "{}",
+        text(&again.stderr)
+    );
+    let nothing = artmesh(&["export", &fit]);
+    assert!(
+        text(&nothing.stderr).contains("--glb"),
+        "{}",
+        text(&nothing.stderr)
+    );
+    let wrong = artmesh(&["export", &demo, "--glb", &tmp.join("x.glb")]);
+    assert_eq!(wrong.status.code(), Some(1));
+    assert!(
+        text(&wrong.stderr).contains("urdf/twin.urdf: missing"),
+        "{}",
+        text(&wrong.stderr)
+    );
+    assert!(!Path::new(&tmp.join("x.glb")).exists());
+}

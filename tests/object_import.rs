@@ -619,7 +619,7 @@ fn object_urdf_writer_round_trips_the_shared_objects() {
         .filter(|k| k.ends_with(".urdf") && !k.ends_with("fridge_static.urdf"))
     {
         let obj = import(path);
-        let files = artmesh::object::write_urdf(&obj, "copy/robot.urdf").unwrap();
+        let files = artmesh::export::write_urdf(&obj, "copy/robot.urdf").unwrap();
         let back = ArticulatedObject::from_urdf("copy/robot.urdf", &files)
             .unwrap_or_else(|e| panic!("{path}: {e}"));
         assert_eq!(back.joints.len(), obj.joints.len(), "{path}");

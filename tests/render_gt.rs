@@ -309,6 +309,7 @@ fn tiny_triangle_lands_where_camera_project_says() {
             positions: corners.to_vec(),
             normals: vec![camera.forward() * -1.0; 3],
             uvs: None,
+            colors: None,
             indices: vec![[0, 1, 2]],
             material: Material::default(),
         };

@@ -148,7 +148,7 @@ fn generated_objects_round_trip_through_urdf() {
             seed: 11,
         };
         let obj = generate(&params).unwrap();
-        let files = artmesh::object::write_urdf(&obj, "object/model.urdf").unwrap();
+        let files = artmesh::export::write_urdf(&obj, "object/model.urdf").unwrap();
         let back = artmesh::object::ArticulatedObject::from_urdf("object/model.urdf", &files)
             .unwrap_or_else(|e| panic!("{category}: {e}"));
         assert!(back.warnings.is_empty(), "{category}: {:?}", back.warnings);
@@ -224,7 +224,7 @@ fn full_suite_objects_are_reproducible() {
     for entry in &plan {
         let write = || {
             let obj = generate(&entry.params()).unwrap_or_else(|e| panic!("{}: {e}", entry.id()));
-            artmesh::object::write_urdf(&obj, "o.urdf").unwrap()
+            artmesh::export::write_urdf(&obj, "o.urdf").unwrap()
         };
         assert!(write() == write(), "{}", entry.id());
     }

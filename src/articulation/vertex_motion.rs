@@ -19,7 +19,7 @@ use glam::{DMat3, DVec3, Vec3};
 
 use super::PartSums;
 use crate::mesh::closest::TriangleBvh;
-use crate::raster::{MeshField, SH_C0, SH_FLOATS};
+use crate::raster::MeshField;
 
 /// One articulation state's mesh as the vertex-wise term sees it: per-vertex position, colour,
 /// opacity and hardened part label, with one closest-point tree per part.
@@ -140,10 +140,8 @@ impl StateSurface {
     pub fn from_field(field: &MeshField) -> Result<Self, String> {
         field.validate()?;
         let parts = crate::mesh::topology::harden_parts(field);
-        let colors = field
-            .sh
-            .chunks_exact(SH_FLOATS)
-            .map(|sh| Vec3::new(sh[0], sh[1], sh[2]) * SH_C0 + 0.5)
+        let colors = (0..field.num_vertices())
+            .map(|v| field.dc_color(v))
             .collect();
         let opacity = field
             .opacity

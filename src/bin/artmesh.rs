@@ -182,7 +182,8 @@ mod cli {
         /// pivot, motion). Writes OUT/joints.json (type, axis origin and direction, motion, limits per
         /// movable part), OUT/gt/ (trans.json and one PLY per part and state: the layout `eval` reads)
         /// and OUT/report.json (times, bake-off losses, warnings, mesh quality, and the paper's metrics
-        /// when the dataset has ground truth); prints the joints and metrics.
+        /// when the dataset has ground truth), and the twin: OUT/urdf/twin.urdf (+ meshes), OUT/twin.glb
+        /// and OUT/twin.zip (both for download); prints the joints and metrics.
         Fit {
             /// Dataset folder (ArtGS / MPArt-90 / PARIS layout, with depth and semantic maps).
             dataset: PathBuf,
@@ -201,6 +202,19 @@ mod cli {
             /// Override the preset's articulation steps.
             #[arg(long)]
             articulation_iterations: Option<u32>,
+        },
+        /// Export a fit folder (what `fit` or `demo` wrote) again: the twin's GLB (a node per part, vertex
+        /// colours, a start-to-end animation, joints in extras) and/or the zip of URDF + meshes +
+        /// joints.json + GLB for simulators. Reads FIT_DIR/urdf/twin.urdf and FIT_DIR/joints.json.
+        Export {
+            /// Folder written by `fit` (or the `fit/` folder inside a `demo` folder).
+            fit_dir: PathBuf,
+            /// New GLB file to write.
+            #[arg(long)]
+            glb: Option<PathBuf>,
+            /// New zip file to write (URDF + meshes + joints.json + GLB under one folder).
+            #[arg(long)]
+            urdf_zip: Option<PathBuf>,
         },
         /// Zero-set-up demo: generate the built-in object (a procedural cabinet with a drawer and a
         /// door), capture it at 64x64 with 12 views per state, fit it, score it against its ground
@@ -575,6 +589,50 @@ mod cli {
                 out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
+            Command::Export {
+                fit_dir,
+                glb,
+                urdf_zip,
+            } => {
+                if glb.is_none() && urdf_zip.is_none() {
+                    return Err(
+                        "export: say what to write: --glb FILE and/or --urdf-zip FILE".into(),
+                    );
+                }
+                for path in glb.iter().chain(&urdf_zip) {
+                    capture::fresh_file(path)?;
+                }
+                let files = data::read_dir(&fit_dir).map_err(|e| e.to_string())?;
+                let shown = |rel: &str| fit_dir.join(rel).display().to_string();
+                let urdf = artmesh::export::URDF_FILE;
+                if !files.contains_key(urdf) {
+                    return Err(format!(
+                        "{}: missing; expected a folder written by `artmesh fit` (or a demo's fit/ folder)",
+                        shown(urdf)
+                    ));
+                }
+                let object = artmesh::object::ArticulatedObject::from_urdf(urdf, &files)
+                    .map_err(|e| format!("{}: {e}", fit_dir.display()))?;
+                let joints_file = artmesh::export::JOINTS_FILE;
+                let joints = files.get(joints_file).ok_or_else(|| {
+                    format!(
+                        "{}: missing (the joints' end-state motions)",
+                        shown(joints_file)
+                    )
+                })?;
+                let end = artmesh::export::end_configuration(&object, joints, &shown(joints_file))
+                    .map_err(|e| e.to_string())?;
+                let exports = artmesh::export::export_twin(&object, &end, joints)
+                    .map_err(|e| e.to_string())?;
+                for (path, bytes) in [(&glb, &exports.glb), (&urdf_zip, &exports.zip)] {
+                    if let Some(path) = path {
+                        std::fs::write(path, bytes)
+                            .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+                        eprintln!("export: wrote {} ({} bytes)", path.display(), bytes.len());
+                    }
+                }
+                Ok(ExitCode::SUCCESS)
+            }
             Command::Demo {
                 out,
                 preset,
@@ -942,14 +1000,23 @@ mod cli {
             "reconstruction": quality,
             "metrics": metrics,
         });
+        let joints_json = to_json(&joints)?.into_bytes();
+        let twin = artmesh::export::Twin::from_fit(&fit, id).map_err(|e| format!("{id}: {e}"))?;
+        let exports =
+            artmesh::export::export_twin(&twin.object(), &twin.end_configuration(), &joints_json)
+                .map_err(|e| format!("{id}: exporting: {e}"))?;
         let mut files = fit.as_ground_truth().to_files();
-        files.insert("joints.json".into(), to_json(&joints)?.into_bytes());
+        let meshes = files.len() - 1;
+        files.insert(artmesh::export::JOINTS_FILE.into(), joints_json);
         files.insert("report.json".into(), to_json(&report)?.into_bytes());
+        files.extend(exports.into_fit_folder());
         data::write_dir(&files, out).map_err(|e| e.to_string())?;
         eprintln!(
-            "fit: {:.0} s; wrote joints.json, report.json and {} part meshes to {}",
-            seconds,
-            files.len() - 3,
+            "fit: {seconds:.0} s; wrote joints.json, report.json, gt/ ({meshes} part meshes), the twin as {} \
+             (+ meshes), {} and {} (all of it for download) to {}",
+            artmesh::export::URDF_FILE,
+            artmesh::export::GLB_FILE,
+            artmesh::export::ZIP_FILE,
             out.display()
         );
         Ok(report)

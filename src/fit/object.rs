@@ -40,6 +40,8 @@ pub struct ObjectFit {
 pub struct JointRecord {
     /// The movable part this joint moves (1 ..= K; part 0 is the static base).
     pub part: usize,
+    /// The joint's name in the exported URDF and GLB (its link is `part_{part}`).
+    pub joint: String,
     #[serde(rename = "type")]
     pub kind: JointKind,
     /// A point on the axis (m); for revolute joints the one closest to the object's centre.
@@ -52,6 +54,8 @@ pub struct JointRecord {
     pub limits: [f32; 2],
     /// The bake-off's masked losses (revolute, prismatic).
     pub bake_off: [Option<f64>; 2],
+    /// The fitted start → end motion g⁺ of the part as a 4 × 4 matrix, rows first (world frame).
+    pub end_transform: [[f64; 4]; 4],
 }
 
 impl ObjectFit {
@@ -70,14 +74,18 @@ impl ObjectFit {
             .iter()
             .map(|j| {
                 let motion = j.joint.motion();
+                let (r, b) = j.motion.forward_affine();
+                let row = |i: usize| [r.row(i).x, r.row(i).y, r.row(i).z, b[i]];
                 JointRecord {
                     part: j.part,
+                    joint: crate::export::twin::part_joint(j.part),
                     kind: j.kind,
                     origin: j.joint.origin.to_array(),
                     direction: j.joint.unit_direction().to_array(),
                     motion,
                     limits: [motion.min(0.0), motion.max(0.0)],
                     bake_off: [j.bake_off.revolute_loss, j.bake_off.prismatic_loss],
+                    end_transform: [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]],
                 }
             })
             .collect()

@@ -8,4 +8,7 @@ mod restricted_delaunay;
 pub mod topology;
 
 pub use restricted_delaunay::{RemeshOptions, part_aware_remesh, restricted_delaunay};
-pub use topology::{EdgeCounts, edge_counts, face_components, harden_parts, part_meshes};
+pub use topology::{
+    EdgeCounts, PartSubmesh, edge_counts, face_components, harden_parts, part_meshes,
+    part_submeshes,
+};

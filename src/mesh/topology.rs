@@ -348,28 +348,52 @@ pub fn thin_vertices(
     (out, smoothed)
 }
 
-/// One triangle mesh per part: each face goes to its [`face_part`], with only the vertices it
-/// uses (positions only; what the exports and the Chamfer distances need).
+/// One mesh per part: each face goes to [`face_part`]'s part, with only the vertices its faces use.
 pub fn part_meshes(
     positions: &[Vec3],
     faces: &[[u32; 3]],
     parts: &[u32],
     num_parts: usize,
 ) -> Vec<TriMesh> {
-    let mut meshes = vec![TriMesh::default(); num_parts];
+    part_submeshes(faces, parts, num_parts)
+        .into_iter()
+        .map(|sub| TriMesh {
+            positions: sub
+                .vertices
+                .iter()
+                .map(|&v| positions[v as usize])
+                .collect(),
+            triangles: sub.triangles,
+        })
+        .collect()
+}
+
+/// A part's share of a mesh: the source vertices it uses and its triangles over them.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct PartSubmesh {
+    /// Source vertex index of each of the part's vertices.
+    pub vertices: Vec<u32>,
+    /// Triangles as indices into `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The split behind [`part_meshes`], keeping the source vertex of each part vertex so per-vertex
+/// attributes (colours) can follow.
+pub fn part_submeshes(faces: &[[u32; 3]], parts: &[u32], num_parts: usize) -> Vec<PartSubmesh> {
+    let mut subs = vec![PartSubmesh::default(); num_parts];
     let mut index: Vec<HashMap<u32, u32>> = vec![HashMap::new(); num_parts];
     for f in faces {
         let k = (face_part(f, parts) as usize).min(num_parts.saturating_sub(1));
-        let mesh = &mut meshes[k];
+        let sub = &mut subs[k];
         let tri = f.map(|v| {
             *index[k].entry(v).or_insert_with(|| {
-                mesh.positions.push(positions[v as usize]);
-                (mesh.positions.len() - 1) as u32
+                sub.vertices.push(v);
+                (sub.vertices.len() - 1) as u32
             })
         });
-        mesh.triangles.push(tri);
+        sub.triangles.push(tri);
     }
-    meshes
+    subs
 }
 
 #[cfg(test)]

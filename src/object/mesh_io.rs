@@ -198,6 +198,12 @@ fn read_obj(
                 .map(|t| Vec2::new(t[0], 1.0 - t[1]))
                 .collect()
         });
+        let colors = (mesh.vertex_color.len() == 3 * n).then(|| {
+            mesh.vertex_color
+                .chunks_exact(3)
+                .map(|c| [c[0], c[1], c[2]])
+                .collect()
+        });
         let material = mesh
             .material_id
             .and_then(|i| decoded.get(i).cloned())
@@ -209,6 +215,7 @@ fn read_obj(
             positions,
             normals,
             uvs,
+            colors,
             indices,
             material,
         });
@@ -360,6 +367,7 @@ fn read_stl(path: &str, bytes: &[u8]) -> Result<Vec<RenderMesh>, DataError> {
         positions,
         normals,
         uvs: None,
+        colors: None,
         indices,
         material: Material {
             name: None,
@@ -613,10 +621,24 @@ impl GltfReader<'_> {
                 }
                 None => None,
             };
+            // COLOR_0 is RGB or RGBA; the alpha of vertex colours is dropped.
+            let colors = match prim.get(&gltf::Semantic::Colors(0)) {
+                Some(acc) => {
+                    let comps = acc.dimensions().multiplicity();
+                    let v: Vec<[f32; 3]> = self
+                        .read_floats(&acc, comps.clamp(3, 4), &what)?
+                        .chunks_exact(comps.clamp(3, 4))
+                        .map(|c| [c[0], c[1], c[2]])
+                        .collect();
+                    (v.len() == n).then_some(v)
+                }
+                None => None,
+            };
             let local = RenderMesh {
                 positions,
                 normals,
                 uvs,
+                colors,
                 indices,
                 material,
             };

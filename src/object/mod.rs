@@ -32,7 +32,6 @@ mod mesh_io;
 mod parts;
 mod primitives;
 mod urdf;
-mod urdf_write;
 
 use std::sync::Arc;
 
@@ -44,7 +43,6 @@ pub use mesh_io::{MeshFormat, load_mesh};
 pub use parts::{MERGE_PRISMATIC_SPAN, MERGE_REVOLUTE_SPAN, Part, Parts, is_merged_chain_joint};
 pub(crate) use primitives::BOX_FACES;
 pub use primitives::{box_mesh, cylinder_mesh, sphere_mesh};
-pub use urdf_write::write_urdf;
 
 /// Sampling range (radians) for continuous joints, which have no limits: one full turn centred on the rest pose.
 pub const CONTINUOUS_RANGE: (f32, f32) = (-std::f32::consts::PI, std::f32::consts::PI);
@@ -82,6 +80,10 @@ pub struct RenderMesh {
     pub normals: Vec<Vec3>,
     /// Texture coordinates, one per position, glTF convention (`v = 0` at the top of the image).
     pub uvs: Option<Vec<Vec2>>,
+    /// Linear RGB per vertex (a fitted twin's colours; glTF `COLOR_0`, OBJ `v x y z r g b`). When present
+    /// they replace the material's RGB, which is then only a fallback for viewers that ignore them. The
+    /// ground-truth renderer ignores them.
+    pub colors: Option<Vec<[f32; 3]>>,
     /// Counter-clockwise triangles (outward normal by the right-hand rule), indices into `positions`.
     pub indices: Vec<[u32; 3]>,
     /// Surface material.
@@ -117,6 +119,7 @@ impl RenderMesh {
             positions,
             normals,
             uvs: self.uvs.clone(),
+            colors: self.colors.clone(),
             indices,
             material: self.material.clone(),
         }
@@ -375,6 +378,12 @@ impl ArticulatedObject {
     /// from the root (impossible for imported objects) stay at the identity.
     pub fn forward_kinematics(&self, q: &[f32]) -> Vec<Affine3A> {
         kinematics::forward_kinematics(self, q)
+    }
+
+    /// Joint indices, parents before children (breadth-first from the root); joints not reachable from
+    /// the root are left out.
+    pub fn joint_order(&self) -> Vec<usize> {
+        kinematics::joint_order(self).0
     }
 
     /// Visual meshes of link `link` in its own frame (see [`Visual::link_frame_meshes`]); empty for a bad index.

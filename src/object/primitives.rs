@@ -127,6 +127,7 @@ fn empty(material: Material) -> RenderMesh {
         positions: Vec::new(),
         normals: Vec::new(),
         uvs: Some(Vec::new()),
+        colors: None,
         indices: Vec::new(),
         material,
     }

@@ -60,6 +60,13 @@ impl MeshField {
         }
     }
 
+    /// Vertex `v`'s view-independent colour (the degree-0 SH term, as [`MeshField::set_color`] sets it),
+    /// in the images' encoding, unclamped.
+    pub fn dc_color(&self, v: usize) -> Vec3 {
+        let sh = &self.sh[v * SH_FLOATS..v * SH_FLOATS + 3];
+        Vec3::new(sh[0], sh[1], sh[2]) * SH_C0 + 0.5
+    }
+
     /// Checks that every array has the length the vertex count implies and every index is valid.
     pub fn validate(&self) -> Result<(), String> {
         let n = self.num_vertices();

@@ -3,7 +3,7 @@
 //!
 //! Every shape is a [`RenderMesh`] with outward counter-clockwise winding, unit normals and UVs of
 //! `position / TILE_METRES` along the face, so a texture keeps its scale whatever the part's size. A link's
-//! meshes become one visual (`Geometry::Mesh` at `meshes/<link>.obj`, what [`crate::object::write_urdf`]
+//! meshes become one visual (`Geometry::Mesh` at `meshes/<link>.obj`, what [`crate::export::write_urdf`]
 //! writes), and one box collision per link fitted to its bounds.
 
 use std::f32::consts::TAU;
@@ -26,6 +26,7 @@ pub(crate) fn empty(material: &Material) -> RenderMesh {
         positions: Vec::new(),
         normals: Vec::new(),
         uvs: Some(Vec::new()),
+        colors: None,
         indices: Vec::new(),
         material: material.clone(),
     }

@@ -4,8 +4,9 @@ use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
 
 use artmesh::data::{self, FileSet, PngPixels, encode_png};
+use artmesh::export::write_urdf;
 use artmesh::gpu::GpuContext;
-use artmesh::object::{ArticulatedObject, write_urdf};
+use artmesh::object::ArticulatedObject;
 use artmesh::render::{
     RenderProgress, RenderSpec, RenderedDataset, SheetEntry, contact_sheet, render_dataset,
 };
