@@ -86,10 +86,20 @@ fn check_in_simulators(
         .iter()
         .zip(values)
         .map(|(j, &value)| {
-            let limit = j.limit.expect("exported joints have limits");
+            use artmesh::object::JointKind;
+            let kind = match j.kind {
+                JointKind::Prismatic => "prismatic",
+                JointKind::Fixed => "fixed",
+                JointKind::Revolute | JointKind::Continuous => "revolute",
+            };
+            let limit = j.limit.unwrap_or(artmesh::object::Limit {
+                lower: 0.0,
+                upper: 0.0,
+                effort: 0.0,
+                velocity: 0.0,
+            });
             serde_json::json!({
-                "name": j.name,
-                "type": if j.kind == artmesh::object::JointKind::Prismatic { "prismatic" } else { "revolute" },
+                "name": j.name, "type": kind,
                 "value": value, "lower": limit.lower, "upper": limit.upper,
             })
         })

@@ -289,4 +289,30 @@ async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
     );
     assert_eq!(fit.articulation.joints[0].kind, JointKind::Revolute);
     assert!(metrics.axis_ang.unwrap() < 10.0, "{metrics:?}");
+
+    // The downloads are made in wasm too: the GLB reads back with the base and its hinged lid, the
+    // zip holds the URDF, its meshes, joints.json and the GLB.
+    let twin = artmesh::export::Twin::from_fit(&fit, "laptop").unwrap();
+    let joints = serde_json::to_vec(&fit.joint_records()).unwrap();
+    let files =
+        artmesh::export::export_twin(&twin.object(), &twin.end_configuration(), &joints).unwrap();
+    let doc = gltf::Gltf::from_slice(&files.glb).unwrap().document;
+    let base = doc.nodes().find(|n| n.name() == Some("base")).unwrap();
+    assert_eq!(
+        base.children()
+            .map(|c| c.name().unwrap_or_default().to_string())
+            .collect::<Vec<_>>(),
+        ["part_1"]
+    );
+    assert_eq!(doc.animations().count(), 1);
+    let zip = zip::ZipArchive::new(std::io::Cursor::new(files.zip)).unwrap();
+    let names: Vec<String> = zip.file_names().map(|n| n.unwrap().to_string()).collect();
+    for want in [
+        "laptop/twin.urdf",
+        "laptop/joints.json",
+        "laptop/twin.glb",
+        "laptop/meshes/part_1_collision.stl",
+    ] {
+        assert!(names.iter().any(|n| n == want), "{want} not in {names:?}");
+    }
 }

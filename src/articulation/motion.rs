@@ -39,15 +39,6 @@ pub struct MotionGradient {
 }
 
 impl MotionGradient {
-    /// The sum of two gradients.
-    pub fn plus(self, o: MotionGradient) -> MotionGradient {
-        MotionGradient {
-            rotation: self.rotation + o.rotation,
-            pivot: self.pivot + o.pivot,
-            translation: self.translation + o.translation,
-        }
-    }
-
     /// Whether every component is finite.
     pub fn is_finite(&self) -> bool {
         self.rotation.is_finite() && self.pivot.is_finite() && self.translation.is_finite()

@@ -22,11 +22,12 @@ use serde::Serialize;
 
 use super::photometric::encode_loss_and_backward;
 use super::reconstruct::{Phase, Preset, Progress, Reconstruction, training_views};
+use super::views::ViewCycle;
 use crate::articulation::init::{JointCandidates, initial_candidates, principal_frame};
 use crate::articulation::kernels::{MotionKernels, MovedMesh};
 use crate::articulation::vertex_motion::{StateSurface, VertexMotionWeights, vertex_motion_loss};
 use crate::articulation::{MotionAdam, MotionMask, MotionRates, PartMotion, PartSums};
-use crate::data::{Camera, Dataset, Frame, GtJoint, JointKind, State};
+use crate::data::{Dataset, Frame, GtJoint, JointKind, State};
 use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
 use crate::loss::{ImageLoss, LossWeights, SSIM_C1, SSIM_C2, TargetImages, TargetView, ssim_taps};
 use crate::raster::{GpuField, MeshField, RasterSettings, RasterState, Rasterizer};
@@ -229,8 +230,7 @@ struct MovedView<'a> {
     loss: ImageLoss,
     targets: TargetImages,
     frames: &'a [Frame],
-    cameras: Vec<Camera>,
-    order: Vec<usize>,
+    views: ViewCycle,
 }
 
 impl<'a> MovedView<'a> {
@@ -253,11 +253,10 @@ impl<'a> MovedView<'a> {
             state: RasterState::new(ctx, w, h, k)?,
             loss: ImageLoss::new(ctx, w, h, k)?,
             targets: TargetImages::upload(ctx, w, h, &views)?,
-            cameras: frames.iter().map(|f| f.camera).collect(),
             field: gpu,
             moved,
             frames,
-            order: Vec::new(),
+            views: ViewCycle::default(),
         })
     }
 
@@ -271,13 +270,7 @@ impl<'a> MovedView<'a> {
         motions: &[(DMat3, DVec3)],
         rng: &mut Rng,
     ) -> GpuResult<Vec<PartSums>> {
-        if self.order.is_empty() {
-            self.order = (0..self.cameras.len()).collect();
-            for k in (1..self.order.len()).rev() {
-                self.order.swap(k, rng.below(k as u32 + 1) as usize);
-            }
-        }
-        let view = self.order.pop().unwrap_or(0);
+        let view = self.views.next(self.frames.len(), rng);
         self.gradient(ctx, r, motions, view).await
     }
 
@@ -323,7 +316,7 @@ impl<'a> MovedView<'a> {
                 ctx,
                 &self.field,
                 &mut self.state,
-                &self.cameras[view],
+                &self.frames[view].camera,
                 &r.settings,
             )
             .await?;
@@ -341,7 +334,7 @@ impl<'a> MovedView<'a> {
         part: usize,
     ) -> GpuResult<(f64, usize)> {
         let (mut sum, mut pixels) = (0.0, 0);
-        for view in 0..self.cameras.len() {
+        for view in 0..self.frames.len() {
             let frame = &self.frames[view];
             let Some(labels) = &frame.parts else {
                 continue;
@@ -376,12 +369,10 @@ fn masked_image_loss(
 ) -> (f64, usize) {
     let (w, h) = (frame.rgba.width as usize, frame.rgba.height as usize);
     let n = w * h;
+    // The target composited over the background exactly as the GPU loss sees it.
+    let planar = super::photometric::target_rgb(frame, background);
     let target: Vec<[f64; 3]> = (0..n)
-        .map(|i| {
-            let px = &frame.rgba.pixels[4 * i..4 * i + 4];
-            let a = f64::from(px[3]) / 255.0;
-            [0, 1, 2].map(|c| f64::from(px[c]) / 255.0 * a + f64::from(background[c]) * (1.0 - a))
-        })
+        .map(|i| [0, 1, 2].map(|c| f64::from(planar[c * n + i])))
         .collect();
     let ssim = ssim_map(planes, &target, w, h);
     let ids = frame.parts.as_ref().map(|p| &p.ids);
@@ -719,26 +710,24 @@ pub async fn articulate(
                 .final_rate
                 .powf(f64::from(i - decide) / f64::from(refine.max(1))),
         );
-        let sums_f = forward
-            .step(ctx, &renderer, &forward_maps(&motions), &mut rng)
-            .await?;
+        // This step's affine maps, both directions, shared by the pixel- and vertex-wise terms.
+        let (g_fwd, g_bwd) = (forward_maps(&motions), backward_maps(&motions));
+        let sums_f = forward.step(ctx, &renderer, &g_fwd, &mut rng).await?;
         let with_backward = config.ablation.backward && i >= backward_from;
         let sums_b = if with_backward {
-            backward
-                .step(ctx, &renderer, &backward_maps(&motions), &mut rng)
-                .await?
+            backward.step(ctx, &renderer, &g_bwd, &mut rng).await?
         } else {
             vec![PartSums::default(); k]
         };
         let mut vertex_loss = None;
         let (mut vf, mut vb) = (vec![PartSums::default(); k], vec![PartSums::default(); k]);
         if vertex_on {
-            let f = vertex_motion_loss(&surface1, &surface2, &forward_maps(&motions), &vertex)
+            let f = vertex_motion_loss(&surface1, &surface2, &g_fwd, &vertex)
                 .map_err(GpuError::InvalidInput)?;
             let mut total = f.loss;
             vf = f.per_part;
             if config.ablation.backward {
-                let b = vertex_motion_loss(&surface2, &surface1, &backward_maps(&motions), &vertex)
+                let b = vertex_motion_loss(&surface2, &surface1, &g_bwd, &vertex)
                     .map_err(GpuError::InvalidInput)?;
                 total += b.loss;
                 vb = b.per_part;

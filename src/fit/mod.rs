@@ -13,4 +13,4 @@ mod subdivide;
 mod views;
 
 pub use subdivide::{subdivide_to_edge, weld};
-pub use views::downsample_frame;
+pub use views::{ViewCycle, downsample_frame};

@@ -11,6 +11,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::subdivide::{subdivide_to_edge, weld};
+use super::views::ViewCycle;
 use crate::data::{Camera, Frame, Split, State};
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 use crate::loss::{ImageLoss, LossTerms, LossWeights, TargetImages, TargetView};
@@ -212,7 +213,9 @@ impl FieldAdam {
     }
 }
 
-fn target_rgb(frame: &Frame, background: Vec3) -> Vec<f32> {
+/// `frame`'s colour composited over `background` by its alpha, as planes (R, G, B): what the
+/// image loss compares a render with.
+pub(crate) fn target_rgb(frame: &Frame, background: Vec3) -> Vec<f32> {
     let img = &frame.rgba;
     let n = (img.width * img.height) as usize;
     let mut out = vec![0.0; 3 * n];
@@ -268,7 +271,7 @@ pub struct Trainer<'a> {
     cameras: &'a [Camera],
     frames: &'a [Frame],
     rng: Rng,
-    order: Vec<usize>,
+    views: ViewCycle,
 }
 
 impl<'a> Trainer<'a> {
@@ -307,7 +310,7 @@ impl<'a> Trainer<'a> {
             cameras,
             frames,
             rng: Rng::new(seed),
-            order: Vec::new(),
+            views: ViewCycle::default(),
         })
     }
 
@@ -323,13 +326,7 @@ impl<'a> Trainer<'a> {
         settings: &RasterSettings,
         weights: &LossWeights,
     ) -> GpuResult<()> {
-        if self.order.is_empty() {
-            self.order = (0..self.cameras.len()).collect();
-            for k in (1..self.order.len()).rev() {
-                self.order.swap(k, self.rng.below(k as u32 + 1) as usize);
-            }
-        }
-        let view = self.order.pop().unwrap_or(0);
+        let view = self.views.next(self.cameras.len(), &mut self.rng);
         self.raster
             .forward(
                 ctx,
@@ -441,7 +438,7 @@ impl<'a> Trainer<'a> {
         self.optimizer = FieldAdam::new(ctx, &gpu_field, lr)?;
         self.field = gpu_field;
         self.rng = Rng::new(seed);
-        self.order.clear();
+        self.views.restart();
         Ok(())
     }
 

@@ -3,6 +3,32 @@
 //! an edge) with its intrinsics scaled to match.
 
 use crate::data::{DepthMap, Frame, PartMap, RgbaImage};
+use crate::rng::Rng;
+
+/// A shuffled cycle through `0..count` views: each view once per cycle, a fresh Fisher–Yates
+/// order (from the caller's generator) when a cycle ends. Both phases' trainers draw from it.
+#[derive(Debug, Clone, Default)]
+pub struct ViewCycle {
+    order: Vec<usize>,
+}
+
+impl ViewCycle {
+    /// The next view of the cycle through `count` views (0 when there are none).
+    pub fn next(&mut self, count: usize, rng: &mut Rng) -> usize {
+        if self.order.is_empty() {
+            self.order = (0..count).collect();
+            for k in (1..self.order.len()).rev() {
+                self.order.swap(k, rng.below(k as u32 + 1) as usize);
+            }
+        }
+        self.order.pop().unwrap_or(0)
+    }
+
+    /// Starts a new cycle at the next call.
+    pub fn restart(&mut self) {
+        self.order.clear();
+    }
+}
 
 /// `frame` reduced by `factor` in each direction (the last partial block is cropped).
 pub fn downsample_frame(frame: &Frame, factor: u32) -> Frame {
