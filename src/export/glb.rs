@@ -43,12 +43,13 @@ pub fn write_glb(
     let mut b = Builder::default();
     b.root.asset.generator = Some(format!("artmesh {}", env!("CARGO_PKG_VERSION")));
 
-    let mut nodes = vec![None; obj.links.len()];
-    let root = obj.root.min(obj.links.len().saturating_sub(1));
     if obj.links.is_empty() {
         return Err(DataError::file(file, "the object has no links to export"));
     }
-    nodes[root] = Some(b.link_node(obj, root, Affine3A::IDENTITY, None, file)?);
+    let mut nodes = vec![None; obj.links.len()];
+    let root = obj.root.min(obj.links.len() - 1);
+    let root_node = b.link_node(obj, root, Affine3A::IDENTITY, None, file)?;
+    nodes[root] = Some(root_node);
     let mut samplers = Vec::new();
     let mut channels = Vec::new();
     for j in obj.joint_order() {
@@ -101,7 +102,7 @@ pub fn write_glb(
     }
     let scene = b.root.push(json::Scene {
         name: Some(obj.name.clone()),
-        nodes: vec![nodes[root].unwrap_or(json::Index::new(0))],
+        nodes: vec![root_node],
         extensions: None,
         extras: None,
     });

@@ -239,8 +239,8 @@ pub fn srgb_to_linear(v: f32) -> f32 {
     }
 }
 
-/// The rotation of `joint` by `angle_deg` about its axis through its origin, as an affine map (a
-/// prismatic joint's shift by `distance`): the start → end transform a joint implies.
+/// The start → end transform a joint implies: a revolute joint's rotation by its motion about its
+/// axis through its origin, or a prismatic joint's shift by its motion along its axis.
 pub fn joint_transform(joint: &GtJoint) -> Affine3A {
     let d = joint.unit_direction();
     match joint.kind {

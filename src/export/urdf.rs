@@ -63,14 +63,7 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
         for c in &link.collisions {
             match &c.geometry {
                 Geometry::Mesh { .. } => collision_meshes.extend(c.link_frame_meshes()),
-                primitive => {
-                    let _ = writeln!(
-                        xml,
-                        "    <collision>\n      {}\n      <geometry>{}</geometry>\n    </collision>",
-                        origin_xml(&c.origin),
-                        primitive_xml(primitive)
-                    );
-                }
+                primitive => xml.push_str(&primitive_collision_xml(&c.origin, primitive)),
             }
         }
         if !collision_meshes.is_empty() {
@@ -80,12 +73,10 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
                 Some((lo, hi)) => {
                     let size = (hi - lo).max(glam::Vec3::splat(MIN_BOX_SIDE));
                     let centre = (lo + hi) * 0.5;
-                    let _ = writeln!(
-                        xml,
-                        "    <collision>\n      {}\n      <geometry>{}</geometry>\n    </collision>",
-                        origin_xml(&Affine3A::from_translation(centre)),
-                        primitive_xml(&Geometry::Box { size })
-                    );
+                    xml.push_str(&primitive_collision_xml(
+                        &Affine3A::from_translation(centre),
+                        &Geometry::Box { size },
+                    ));
                 }
                 None => {
                     let path = format!("meshes/{stem}_collision.stl");
@@ -163,6 +154,15 @@ fn origin_xml(t: &Affine3A) -> String {
     format!(
         "<origin xyz=\"{} {} {}\" rpy=\"{roll} {pitch} {yaw}\"/>",
         translation.x, translation.y, translation.z
+    )
+}
+
+/// A `<collision>` element (with its line break) holding primitive `g` at `origin`.
+fn primitive_collision_xml(origin: &Affine3A, g: &Geometry) -> String {
+    format!(
+        "    <collision>\n      {}\n      <geometry>{}</geometry>\n    </collision>\n",
+        origin_xml(origin),
+        primitive_xml(g)
     )
 }
 
