@@ -15,8 +15,6 @@ struct Frame {
 }
 
 struct MeshParams {
-    // Linear RGBA factor.
-    base_color: vec4<f32>,
     // Part id written to the part target.
     part: i32,
     // 1 when the texture holds the material's base-colour texture, 0 for the 1×1 white stand-in.
@@ -34,6 +32,8 @@ struct VertexIn {
     @location(0) position: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    // Linear base colour (vertex colour, or the material's on every vertex).
+    @location(3) color: vec3<f32>,
 }
 
 struct VertexOut {
@@ -43,6 +43,7 @@ struct VertexOut {
     @location(0) camera: vec3<f32>,
     @location(1) normal: vec3<f32>,
     @location(2) uv: vec2<f32>,
+    @location(3) color: vec3<f32>,
 }
 
 @vertex
@@ -59,6 +60,7 @@ fn vs_main(v: VertexIn) -> VertexOut {
     out.camera = p.xyz;
     out.normal = (frame.world_to_camera * vec4<f32>(v.normal, 0.0)).xyz;
     out.uv = v.uv;
+    out.color = v.color;
     return out;
 }
 
@@ -78,7 +80,7 @@ fn srgb_encode(c: vec3<f32>) -> vec3<f32> {
 
 @fragment
 fn fs_main(f: VertexOut) -> FragmentOut {
-    var albedo = mesh.base_color.rgb;
+    var albedo = f.color;
     // Sampled unconditionally (uniform control flow); the stand-in texture is white.
     let texel = textureSample(base_texture, base_sampler, f.uv);
     if mesh.textured != 0u {

@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use crate::fit::observer::Unobserved;
 use crate::gpu::{AdapterReport, GpuContext, GpuResult, RadixSort, key_mask};
 use crate::rng::Rng;
 
@@ -441,8 +442,13 @@ fn capture_entry(
         seed: entry.seed,
         ..crate::render::RenderSpec::default()
     };
-    pollster::block_on(crate::render::capture_dataset(ctx, &object, &spec))
-        .map_err(|e| format!("{id}: {e}"))
+    pollster::block_on(crate::render::capture_dataset(
+        ctx,
+        &object,
+        &spec,
+        &mut |_| {},
+    ))
+    .map_err(|e| format!("{id}: {e}"))
 }
 
 /// Reconstructs the quick-suite objects (all, or those whose id contains one of `only`), each
@@ -469,7 +475,7 @@ pub fn reconstruct(
             ctx,
             &dataset,
             config,
-            &mut |_| {},
+            &mut Unobserved,
         ))
         .map_err(|e| format!("{id}: {e}"))?;
         let seconds = start.elapsed().as_secs_f64();
@@ -615,7 +621,7 @@ pub fn fit(
             ctx,
             &dataset,
             &config.reconstruction,
-            &mut |_| {},
+            &mut Unobserved,
         ))
         .map_err(|e| named(e.to_string()))?;
         let reconstruct_s = start.elapsed().as_secs_f64();
@@ -624,7 +630,7 @@ pub fn fit(
             &dataset,
             &reconstruction,
             &config.articulation,
-            &mut |_| {},
+            &mut Unobserved,
         ))
         .map_err(|e| named(e.to_string()))?;
         let seconds = start.elapsed().as_secs_f64();
@@ -658,7 +664,7 @@ pub fn fit(
                     &dataset,
                     &fit.reconstruction,
                     &articulation,
-                    &mut |_| {},
+                    &mut Unobserved,
                 ))
                 .map_err(|e| named(e.to_string()))?;
                 run.objects.push(score(&fit)?);
@@ -668,14 +674,14 @@ pub fn fit(
                 ..config.reconstruction
             };
             fit.reconstruction =
-                pollster::block_on(reconstruct(ctx, &dataset, &global, &mut |_| {}))
+                pollster::block_on(reconstruct(ctx, &dataset, &global, &mut Unobserved))
                     .map_err(|e| named(e.to_string()))?;
             fit.articulation = pollster::block_on(articulate(
                 ctx,
                 &dataset,
                 &fit.reconstruction,
                 &config.articulation,
-                &mut |_| {},
+                &mut Unobserved,
             ))
             .map_err(|e| named(e.to_string()))?;
             runs[4].objects.push(score(&fit)?);

@@ -1,115 +1,316 @@
-// The page's driver: loads the wasm module, reports the WebGPU adapter, runs the GPU self-test
-// and checks dropped datasets. All computation happens in the wasm module; this file only
-// moves data in and shows results. `document.body.dataset.state` tells tests where it is.
-import init, { adapter_report, gpu_self_test, inspect_dataset } from "./pkg/artmesh.js";
+// The page's driver: loads the wasm module, reports the WebGPU adapter, runs the GPU self-test on
+// request, takes a demo object or a dataset, runs the fit and shows the twin. All computation
+// happens in the wasm module (web/pkg); these files only move data in and show results.
+// `document.body.dataset.state` tells tests where the page is: loading → done | error | panic.
+import { $, show, errorText, showBanner, hideBanner } from "./util.js";
+import { setupInput, showDataset } from "./input.js";
+import { wireFitButtons, runFit, markFitDone } from "./fit-ui.js";
+import { wireResultButtons, showResult, clearResult } from "./result-ui.js";
 
-const $ = (id) => document.getElementById(id);
 const params = new URLSearchParams(location.search);
 const maxSize = Number(params.get("max") ?? 1000003);
 
-function show(el, text, cls) {
-  el.textContent = text;
-  el.className = "status" + (cls ? " " + cls : "");
+let wasm = null;         // the wasm module's exports (web/pkg/artmesh.js)
+let gpuOk = false;       // a WebGPU adapter answered
+let busy = false;        // a GPU job (self-test, demo, fit) is running
+let broken = false;      // after a panic or a lost device only a reload helps
+let currentDataset = null;
+let catalogue = { categories: [], presets: [], default: {} };
+
+function updateButtons() {
+  const gpu = gpuOk && !broken;
+  $("selftest-run").disabled = !gpu || busy;
+  $("demo-run").disabled = !gpu || busy;
+  $("fit-run").disabled = !gpu || busy || !currentDataset;
+}
+
+function freeQuietly(handle) {
+  try { handle?.free?.(); } catch { /* already freed */ }
+}
+
+// --- errors that end the session ----------------------------------------------------------
+
+function wireFatalEvents() {
+  window.addEventListener("artmesh-panic", (e) => {
+    broken = true;
+    document.body.dataset.state = "panic";
+    document.body.dataset.error = String(e.detail ?? "panic");
+    if (["running", "paused"].includes(document.body.dataset.fit)) document.body.dataset.fit = "error";
+    showBanner(`artmesh stopped on an internal error and cannot go on: ${e.detail ?? "unknown"}`,
+      { label: "Reload page", run: () => location.reload() });
+    updateButtons();
+  });
+  window.addEventListener("artmesh-device-lost", (e) => {
+    const reason = String(e.detail ?? "unknown reason");
+    // A device destroyed on purpose (its context dropped) is not a loss.
+    if (/^\s*destroyed\b/i.test(reason)) return;
+    broken = true;
+    document.body.dataset.deviceLost = "1";
+    showBanner(`The GPU device was lost (${reason}). This happens when the graphics driver resets or the GPU ` +
+      `runs out of memory. Restart the page to go on.`, { label: "Restart", run: () => location.reload() });
+    updateButtons();
+  });
+}
+
+// --- 1. the GPU ---------------------------------------------------------------------------
+
+function noGpu(message) {
+  gpuOk = false;
+  show($("adapter"), message, "fail");
+  const note = $("gpu-needed");
+  note.hidden = false;
+  note.textContent = "Generating and fitting need WebGPU, so those buttons are off. You can still check a dataset.";
+  document.body.dataset.selftest = "skipped";
 }
 
 async function gpuSection() {
   if (!navigator.gpu) {
-    show($("adapter"), "This browser has no WebGPU. Use Chrome or Edge 113+ (on Linux start Chromium with " +
-      "--enable-unsafe-webgpu), Safari 26+, or Firefox 141+ on Windows.", "fail");
-    show($("selftest-status"), "Skipped: no WebGPU.", "fail");
-    document.body.dataset.selftest = "skipped";
-    return;
+    noGpu("This browser has no WebGPU. Use Chrome or Edge 113+ (on Linux start Chromium with " +
+      "--enable-unsafe-webgpu), Safari 26+, or Firefox 141+ on Windows.");
+    return true;
   }
-  const adapter = JSON.parse(await adapter_report());
+  let adapter;
+  try {
+    adapter = JSON.parse(await wasm.adapter_report());
+  } catch (e) {
+    noGpu(`WebGPU is there but no GPU adapter could be opened: ${errorText(e)}\n` +
+      "Check that hardware acceleration is on in the browser's settings.");
+    document.body.dataset.error = errorText(e);
+    return false;
+  }
   // The browser's own adapter info names the vendor and architecture even when it hides the description.
-  const info = (await navigator.gpu.requestAdapter())?.info;
+  let info = null;
+  try { info = (await navigator.gpu.requestAdapter())?.info; } catch { /* optional */ }
   const vendor = [info?.vendor, info?.architecture].filter(Boolean).join(" ");
   const name = vendor ? `${vendor} — ${adapter.name}` : adapter.name;
   document.body.dataset.adapter = name;
-  show($("adapter"), `${name} (${adapter.device_type === "Cpu" ? "software" : "hardware"} WebGPU)\n` +
+  const software = adapter.device_type === "Cpu";
+  show($("adapter"), `${name} (${software ? "software" : "hardware"} WebGPU)\n` +
     `largest storage binding ${(adapter.max_storage_buffer_binding_size / 2 ** 20).toFixed(0)} MiB, ` +
-    `${adapter.max_compute_workgroups_per_dimension} workgroups per dimension`, "ok");
+    `${adapter.max_compute_workgroups_per_dimension} workgroups per dimension` +
+    (software ? "\nA software adapter is slow: use the tiny preset." : ""), "ok");
+  gpuOk = true;
+  return true;
+}
 
-  show($("selftest-status"), "Running prefix sum and radix sort on the GPU…");
-  const t0 = performance.now();
-  const result = JSON.parse(await gpu_self_test(maxSize));
-  const seconds = ((performance.now() - t0) / 1000).toFixed(1);
+async function selfTest() {
+  if (busy) return;
+  busy = true;
+  updateButtons();
+  delete document.body.dataset.selftest;
+  const status = $("selftest-status");
+  show(status, "Running prefix sum and radix sort on the GPU…");
   const body = $("selftest-table").querySelector("tbody");
-  for (const c of result.report.checks) {
-    const row = body.insertRow();
-    for (const v of [c.kernel, c.n.toLocaleString("en"), c.key_bits || "—"]) row.insertCell().textContent = v;
-    const verdict = row.insertCell();
-    verdict.textContent = c.mismatches === 0 ? "matches CPU" : `${c.mismatches} mismatches (first at ${c.first_mismatch})`;
-    verdict.className = c.mismatches === 0 ? "ok" : "fail";
-  }
-  $("selftest-table").hidden = false;
-  const n = result.report.checks.length;
-  show($("selftest-status"), result.passed ? `All ${n} checks match the CPU (${seconds} s).`
-    : `Some checks differ from the CPU: see the table.`, result.passed ? "ok" : "fail");
-  document.body.dataset.selftest = result.passed ? "pass" : "fail";
-}
-
-// --- dataset drop -------------------------------------------------------------------------
-
-async function readEntry(entry, prefix, out) {
-  if (entry.isFile) {
-    const file = await new Promise((res, rej) => entry.file(res, rej));
-    out.push([prefix + entry.name, file]);
-  } else if (entry.isDirectory) {
-    const reader = entry.createReader();
-    for (;;) {
-      const batch = await new Promise((res, rej) => reader.readEntries(res, rej));
-      if (batch.length === 0) break;
-      for (const child of batch) await readEntry(child, prefix + entry.name + "/", out);
+  body.replaceChildren();
+  $("selftest-table").hidden = true;
+  const t0 = performance.now();
+  try {
+    const result = JSON.parse(await wasm.gpu_self_test(maxSize));
+    const seconds = ((performance.now() - t0) / 1000).toFixed(1);
+    for (const c of result.report.checks) {
+      const row = body.insertRow();
+      for (const v of [c.kernel, c.n.toLocaleString("en"), c.key_bits || "—"]) row.insertCell().textContent = v;
+      const verdict = row.insertCell();
+      verdict.textContent = c.mismatches === 0 ? "matches CPU" : `${c.mismatches} mismatches (first at ${c.first_mismatch})`;
+      verdict.className = c.mismatches === 0 ? "ok" : "fail";
     }
+    $("selftest-table").hidden = false;
+    const n = result.report.checks.length;
+    show(status, result.passed ? `All ${n} checks match the CPU (${seconds} s).`
+      : "Some checks differ from the CPU: see the table. Fits on this GPU may be wrong.", result.passed ? "ok" : "fail");
+    document.body.dataset.selftest = result.passed ? "pass" : "fail";
+  } catch (e) {
+    show(status, `The self-test could not run: ${errorText(e)}`, "fail");
+    document.body.dataset.selftest = "fail";
+  } finally {
+    busy = false;
+    updateButtons();
   }
 }
 
-async function inspect(pairs) {
-  // Paths relative to the dropped folder: drop its own name.
-  const strip = (p) => p.split("/").slice(1).join("/");
-  const paths = [], contents = [];
-  for (const [path, file] of pairs) {
-    if (file.name.startsWith(".")) continue;
-    paths.push(strip(path));
-    contents.push(new Uint8Array(await file.arrayBuffer()));
-  }
-  const result = JSON.parse(inspect_dataset(paths, contents));
-  const out = $("dataset-result");
-  out.hidden = false;
-  out.textContent = result.ok ? result.text : `${result.problems.length} problem(s) found:\n` + result.problems.join("\n");
-  out.className = result.ok ? "ok" : "fail";
-  document.body.dataset.dataset = result.ok ? "ok" : "problems";
+// --- 2. input -----------------------------------------------------------------------------
+
+function option(select, value, text) {
+  const o = document.createElement("option");
+  o.value = value;
+  o.textContent = text;
+  select.append(o);
 }
 
-function wireDrop() {
-  const zone = $("dropzone");
-  zone.addEventListener("dragover", (e) => { e.preventDefault(); zone.classList.add("over"); });
-  zone.addEventListener("dragleave", () => zone.classList.remove("over"));
-  zone.addEventListener("drop", async (e) => {
-    e.preventDefault();
-    zone.classList.remove("over");
-    const pairs = [];
-    for (const item of e.dataTransfer.items) {
-      const entry = item.webkitGetAsEntry?.();
-      if (entry) await readEntry(entry, "", pairs);
+function fillForms() {
+  const d = catalogue.default ?? {};
+  const cat = $("demo-category");
+  for (const c of catalogue.categories) option(cat, c.name, c.label && c.label !== c.name ? `${c.label} (${c.name})` : c.name);
+  if (d.category) cat.value = d.category;
+  const names = catalogue.presets.map((p) => p.name);
+  const wanted = params.get("preset");
+  const preset = names.includes(wanted) ? wanted : (d.preset ?? names[0]);
+  for (const [select, about] of [[$("demo-preset"), $("demo-preset-about")], [$("fit-preset"), $("fit-preset-about")]]) {
+    for (const p of catalogue.presets) option(select, p.name, p.name);
+    select.value = preset;
+    const describe = () => {
+      about.textContent = catalogue.presets.find((p) => p.name === select.value)?.about ?? "";
+    };
+    select.addEventListener("change", describe);
+    describe();
+  }
+  const setRange = (parts) => {
+    const c = catalogue.categories.find((c) => c.name === cat.value);
+    const [lo, hi] = c?.parts ?? [1, 15];
+    const input = $("demo-parts");
+    input.min = String(lo);
+    input.max = String(hi);
+    input.value = String(Math.min(hi, Math.max(lo, parts ?? c?.default_parts ?? lo)));
+  };
+  cat.addEventListener("change", () => setRange(null));
+  setRange(d.parts);
+  $("demo-seed").value = String(d.seed ?? 0);
+}
+
+function setDataset(ds) {
+  if (currentDataset && currentDataset !== ds) freeQuietly(currentDataset);
+  currentDataset = ds;
+  showDataset(ds);
+  updateButtons();
+}
+
+function readDemoForm() {
+  const parts = $("demo-parts");
+  let n = Math.round(Number(parts.value));
+  if (!Number.isFinite(n)) n = Number(parts.min) || 1;
+  n = Math.min(Number(parts.max) || 15, Math.max(Number(parts.min) || 1, n));
+  parts.value = String(n);
+  let seed = Math.round(Number($("demo-seed").value));
+  if (!Number.isFinite(seed) || seed < 0) seed = 0;
+  $("demo-seed").value = String(seed);
+  return { category: $("demo-category").value, parts: n, preset: $("demo-preset").value, seed };
+}
+
+async function runDemo() {
+  if (busy || broken) return;
+  busy = true;
+  updateButtons();
+  hideBanner();
+  clearResult();
+  const { category, parts, preset, seed } = readDemoForm();
+  const status = $("demo-status");
+  const progress = $("demo-progress");
+  progress.hidden = false;
+  progress.value = 0;
+  document.body.dataset.demo = "rendering";
+  status.textContent = `Generating a ${category} with ${parts} movable part(s) and photographing both states…`;
+  try {
+    let ds;
+    try {
+      ds = await wasm.Dataset.demo(category, parts, preset, seed, (p) => {
+        if (!p || !(p.total > 0)) return;
+        progress.value = p.done / p.total;
+        status.textContent = `Photographing the object: ${p.done} of ${p.total} views rendered.`;
+      });
+    } catch (e) {
+      document.body.dataset.demo = "error";
+      status.textContent = `The demo object could not be made: ${errorText(e)}`;
+      showBanner(`The demo object could not be made: ${errorText(e)}`);
+      return;
     }
-    await inspect(pairs);
-  });
-  $("folder").addEventListener("change", (e) =>
-    inspect([...e.target.files].map((f) => [f.webkitRelativePath || f.name, f])));
+    progress.value = 1;
+    document.body.dataset.demo = "rendered";
+    status.textContent = "Photographed; now fitting (see Fit).";
+    setDataset(ds);
+    await doFit(ds, preset, `the demo ${category}`);
+    status.textContent = document.body.dataset.fit === "done" ? "Done: the twin is under Result."
+      : "The fit did not finish: see Fit.";
+  } finally {
+    busy = false;
+    updateButtons();
+  }
 }
+
+// --- 3. + 4. fit and result ---------------------------------------------------------------
+
+async function doFit(ds, preset, what) {
+  clearResult();
+  delete window.artmeshLast;
+  $("fit").scrollIntoView?.({ behavior: "smooth", block: "start" });
+  let handle;
+  try {
+    handle = ds.share();
+  } catch (e) {
+    showBanner(`The dataset is no longer available: ${errorText(e)}`);
+    document.body.dataset.fit = "error";
+    return;
+  }
+  const r = await runFit(wasm.fit, handle, preset, what);
+  if (!r) {
+    $("result-empty").textContent = "No twin: the fit did not finish.";
+    return;
+  }
+  try {
+    window.artmeshLast = { joints: r.joints(), report: r.report() };
+  } catch (e) {
+    console.error("result:", e);
+  }
+  markFitDone();
+  try {
+    await showResult(wasm.Viewer, r);
+  } catch (e) {
+    showBanner(`The result could not be shown: ${errorText(e)}`);
+  }
+}
+
+async function fitCurrent() {
+  if (busy || broken || !currentDataset) return;
+  busy = true;
+  updateButtons();
+  hideBanner();
+  try {
+    let name = "your dataset";
+    try { name = currentDataset.name() || name; } catch { /* unnamed */ }
+    await doFit(currentDataset, $("fit-preset").value, name);
+  } finally {
+    busy = false;
+    updateButtons();
+  }
+}
+
+// --- start --------------------------------------------------------------------------------
 
 async function main() {
+  wireFatalEvents();
   try {
-    await init();
-    wireDrop();
-    await gpuSection();
-    document.body.dataset.state = "done";
+    try {
+      wasm = await import("./pkg/artmesh.js");
+    } catch (e) {
+      throw new Error(`the wasm module (web/pkg) did not load: ${errorText(e)}; build it with web/build.sh`);
+    }
+    const missing = ["adapter_report", "gpu_self_test", "catalogue", "fit", "Dataset", "Viewer"].filter((n) => !wasm[n]);
+    if (missing.length) throw new Error(`web/pkg is out of date (missing ${missing.join(", ")}): rebuild it with web/build.sh`);
+    await wasm.default();
+    catalogue = JSON.parse(wasm.catalogue());
+    window.artmeshCatalogue = catalogue;
+    fillForms();
+    setupInput(wasm.Dataset, {
+      onDataset: setDataset,
+      onProblems: () => {
+        freeQuietly(currentDataset);
+        currentDataset = null;
+        updateButtons();
+      },
+    });
+    wireFitButtons();
+    wireResultButtons();
+    $("selftest-run").addEventListener("click", selfTest);
+    $("demo-run").addEventListener("click", runDemo);
+    $("fit-run").addEventListener("click", fitCurrent);
+    const ok = await gpuSection();
+    updateButtons();
+    if (document.body.dataset.state !== "panic") document.body.dataset.state = ok ? "done" : "error";
   } catch (e) {
-    show($("selftest-status"), `Error: ${e.message ?? e}`, "fail");
+    const message = errorText(e);
+    show($("adapter"), `The page could not start: ${message}`, "fail");
+    showBanner(`The page could not start: ${message}`, { label: "Reload page", run: () => location.reload() });
     document.body.dataset.state = "error";
-    document.body.dataset.error = String(e.message ?? e);
+    document.body.dataset.error = message;
   }
 }
 

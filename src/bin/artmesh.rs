@@ -19,6 +19,7 @@ mod cli {
 
     use artmesh::data::{self, Dataset, GroundTruth, State, fixture};
     use artmesh::eval;
+    use artmesh::fit::reconstruct::Progress;
     use artmesh::gpu::{GpuContext, selftest};
     use artmesh::render::RenderSpec;
     use clap::{Parser, Subcommand};
@@ -663,24 +664,20 @@ mod cli {
                     seed,
                 })?;
                 let config = fit_config(&preset)?;
-                let size = config.reconstruction.max_size.clamp(32, 512);
-                let views = config.reconstruction.max_views.clamp(4, 100);
-                let spec = RenderSpec {
-                    width: size,
-                    height: size,
-                    train_views: views,
-                    test_views: 0,
-                    seed,
-                    ..RenderSpec::default()
-                };
+                let spec = config.demo_capture(seed);
+                let (size, views) = (spec.width, spec.train_views);
                 let ctx = context()?;
                 eprintln!(
                     "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state",
                     object.name, parts
                 );
-                let dataset =
-                    pollster::block_on(artmesh::render::capture_dataset(&ctx, &object, &spec))
-                        .map_err(|e| format!("{}: {e}", object.name))?;
+                let dataset = pollster::block_on(artmesh::render::capture_dataset(
+                    &ctx,
+                    &object,
+                    &spec,
+                    &mut |_| {},
+                ))
+                .map_err(|e| format!("{}: {e}", object.name))?;
                 let files = dataset.to_files().map_err(|e| e.to_string())?;
                 data::write_dir(&files, &out.join("dataset")).map_err(|e| e.to_string())?;
                 let report = fit_and_write(
@@ -942,25 +939,18 @@ mod cli {
             &ctx,
             dataset,
             config,
-            &mut |p| bar.show(p),
+            &mut |p: &Progress| bar.show(p),
         ))
         .map_err(|e| format!("{id}: {e}"))?;
         bar.finish();
         let seconds = start.elapsed().as_secs_f64();
-        let quality = eval::reconstruction_report(
-            &fit.reconstruction,
-            &dataset.gt_meshes,
-            &eval::ChamferOptions::default(),
-        );
-        let metrics = fit
-            .evaluate(dataset, id, category, &eval::EvalOptions::default())
-            .transpose()
-            .map_err(|e| format!("{id}: scoring against the ground truth: {e}"))?;
-        let joints = fit.joint_records();
+        let folder =
+            artmesh::export::FitFolder::build(&fit, dataset, config, id, category, seconds)?;
+        let (joints, metrics) = (&folder.joints, &folder.metrics);
         for w in &fit.articulation.warnings {
             eprintln!("fit: warning: {w}");
         }
-        for j in &joints {
+        for j in joints {
             let unit = if j.kind == data::JointKind::Revolute {
                 "°"
             } else {
@@ -971,7 +961,7 @@ mod cli {
                 j.part, j.kind, j.direction, j.origin, j.motion, j.bake_off
             );
         }
-        if let Some(m) = &metrics {
+        if let Some(m) = metrics {
             let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
             eprintln!(
                 "fit: against the ground truth: Axis Ang {} °, Axis Pos {} (0.1 m), Part Motion {}, CD-s {} ({} mm), CD-m {} ({} mm), joint types {}/{} right",
@@ -986,31 +976,8 @@ mod cli {
                 m.joints.len() + m.unmatched_gt.len()
             );
         }
-        let report = serde_json::json!({
-            "id": id,
-            "seconds": seconds,
-            "config": config,
-            "joints": joints,
-            "warnings": fit.articulation.warnings,
-            "articulation": {
-                "times": fit.articulation.times,
-                "curve": fit.articulation.curve,
-                "fitted": fit.articulation.joints,
-            },
-            "reconstruction": quality,
-            "metrics": metrics,
-        });
-        let joints_json = to_json(&joints)?.into_bytes();
-        let twin = artmesh::export::Twin::from_fit(&fit, id).map_err(|e| format!("{id}: {e}"))?;
-        let exports =
-            artmesh::export::export_twin(&twin.object(), &twin.end_configuration(), &joints_json)
-                .map_err(|e| format!("{id}: exporting: {e}"))?;
-        let mut files = fit.as_ground_truth().to_files();
-        let meshes = files.len() - 1;
-        files.insert(artmesh::export::JOINTS_FILE.into(), joints_json);
-        files.insert("report.json".into(), to_json(&report)?.into_bytes());
-        files.extend(exports.into_fit_folder());
-        data::write_dir(&files, out).map_err(|e| e.to_string())?;
+        let meshes = folder.files.keys().filter(|p| p.ends_with(".ply")).count();
+        data::write_dir(&folder.files, out).map_err(|e| e.to_string())?;
         eprintln!(
             "fit: {seconds:.0} s; wrote joints.json, report.json, gt/ ({meshes} part meshes), the twin as {} \
              (+ meshes), {} and {} (all of it for download) to {}",
@@ -1019,7 +986,7 @@ mod cli {
             artmesh::export::ZIP_FILE,
             out.display()
         );
-        Ok(report)
+        Ok(folder.report)
     }
 
     /// Both phases' settings of the named preset.
@@ -1059,7 +1026,7 @@ mod cli {
             &ctx,
             &dataset,
             config,
-            &mut |p| bar.show(p),
+            &mut |p: &Progress| bar.show(p),
         ))
         .map_err(|e| format!("{}: {e}", root.display()))?;
         bar.finish();

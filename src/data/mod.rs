@@ -15,6 +15,7 @@
 //! gt/{state}/{state}_static_rotate.ply, gt/{state}/{state}_dynamic_{i}_rotate.ply   optional GT part meshes
 //! ```
 
+mod archive;
 mod camera;
 mod dataset;
 mod error;
@@ -33,6 +34,7 @@ mod writer;
 
 use std::collections::BTreeMap;
 
+pub use archive::read_zip;
 pub use camera::{Camera, Intrinsics, look_at};
 pub use dataset::{Dataset, Frame, GroundTruth, SemanticFormat, ViewSet, WriteOptions};
 pub use error::{DataError, DatasetErrors};

@@ -153,6 +153,7 @@ pub async fn tiny_reconstruction(
     ctx: &crate::gpu::GpuContext,
     remesh: crate::fit::reconstruct::RemeshMode,
 ) -> Result<(Reconstruction, ReconstructionReport), String> {
+    use crate::fit::observer::Unobserved;
     use crate::fit::reconstruct::{Preset, ReconstructionConfig, reconstruct};
     let object = crate::synth::generate(&crate::synth::SynthParams {
         category: crate::synth::Category::Laptop,
@@ -167,12 +168,12 @@ pub async fn tiny_reconstruction(
         seed: 1005,
         ..crate::render::RenderSpec::default()
     };
-    let dataset = crate::render::capture_dataset(ctx, &object, &spec).await?;
+    let dataset = crate::render::capture_dataset(ctx, &object, &spec, &mut |_| {}).await?;
     let config = ReconstructionConfig {
         remesh,
         ..ReconstructionConfig::preset(Preset::Tiny)
     };
-    let reconstruction = reconstruct(ctx, &dataset, &config, &mut |_| {})
+    let reconstruction = reconstruct(ctx, &dataset, &config, &mut Unobserved)
         .await
         .map_err(|e| e.to_string())?;
     let report = reconstruction_report(

@@ -7,16 +7,20 @@
 //! - [`glb`]: binary glTF with the link tree as nodes, vertex colours, a start → end animation and
 //!   the joints in `extras`.
 //! - [`archive`]: everything as one zip whose paths cannot leave the folder it is unpacked in.
+//! - [`folder`]: all of a fit's files (report, joints, part meshes, exports) for the CLI's fit
+//!   folder and the page's downloads.
 //!
 //! Like the rest of the core, bytes in and bytes out: the browser app downloads what these return.
 
 pub mod archive;
+pub mod folder;
 pub mod glb;
 pub mod inertia;
 pub mod twin;
 pub mod urdf;
 
 pub use archive::write_zip;
+pub use folder::{FitFolder, REPORT_FILE};
 pub use glb::write_glb;
 pub use twin::{Twin, TwinPart};
 pub use urdf::write_urdf;

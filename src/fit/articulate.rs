@@ -20,6 +20,7 @@
 use glam::{DMat3, DVec3, Vec3};
 use serde::Serialize;
 
+use super::observer::{Observer, checkpoint};
 use super::photometric::encode_loss_and_backward;
 use super::reconstruct::{Phase, Preset, Progress, Reconstruction, training_views};
 use super::views::ViewCycle;
@@ -491,7 +492,7 @@ pub async fn articulate(
     dataset: &Dataset,
     rec: &Reconstruction,
     config: &ArticulationConfig,
-    progress: &mut dyn FnMut(&Progress),
+    observer: &mut dyn Observer,
 ) -> GpuResult<Articulation> {
     let t0 = now_seconds();
     let mut times = ArticulationTimes::default();
@@ -573,7 +574,7 @@ pub async fn articulate(
         faces: s1.field.faces.len() + s2.field.faces.len(),
         elapsed_s: now_seconds() - t0,
     };
-    progress(&event(Phase::Candidates, 0, decide, None));
+    checkpoint(observer, &event(Phase::Candidates, 0, decide, None)).await?;
 
     // 1. Candidates, alternating.
     let mut adam_rot = MotionAdam::new(k, config.rates);
@@ -618,14 +619,18 @@ pub async fn articulate(
                 backward_loss: None,
                 vertex_loss: None,
             });
-            progress(&event(Phase::Candidates, i + 1, decide, Some(terms.total)));
+            checkpoint(
+                observer,
+                &event(Phase::Candidates, i + 1, decide, Some(terms.total)),
+            )
+            .await?;
         }
     }
     times.candidates_s = now_seconds() - t_candidates;
 
     // 2. Bake-off.
     let t_bake = now_seconds();
-    progress(&event(Phase::BakeOff, 0, (k - 1) as u32, None));
+    checkpoint(observer, &event(Phase::BakeOff, 0, (k - 1) as u32, None)).await?;
     let mut kinds = vec![JointKind::Revolute; k];
     let mut bake_offs = vec![
         BakeOff {
@@ -674,7 +679,11 @@ pub async fn articulate(
             pixels,
             kind,
         };
-        progress(&event(Phase::BakeOff, part as u32, (k - 1) as u32, None));
+        checkpoint(
+            observer,
+            &event(Phase::BakeOff, part as u32, (k - 1) as u32, None),
+        )
+        .await?;
     }
     let mut motions: Vec<PartMotion> = (0..k)
         .map(|p| match kinds[p] {
@@ -703,7 +712,7 @@ pub async fn articulate(
     };
     let vertex_on = vertex.color > 0.0 || vertex.opacity > 0.0;
     let refine = n - decide;
-    progress(&event(Phase::Refine, 0, refine, None));
+    checkpoint(observer, &event(Phase::Refine, 0, refine, None)).await?;
     for i in decide..n {
         adam.set_scale(
             config
@@ -759,7 +768,11 @@ pub async fn articulate(
                 backward_loss,
                 vertex_loss,
             });
-            progress(&event(Phase::Refine, step + 1, refine, Some(terms.total)));
+            checkpoint(
+                observer,
+                &event(Phase::Refine, step + 1, refine, Some(terms.total)),
+            )
+            .await?;
         }
     }
     times.refine_s = now_seconds() - t_refine;
@@ -796,7 +809,7 @@ pub async fn articulate(
         }
     }
     times.total_s = now_seconds() - t0;
-    progress(&event(Phase::Done, refine, refine, None));
+    checkpoint(observer, &event(Phase::Done, refine, refine, None)).await?;
     Ok(Articulation {
         config: *config,
         joints,

@@ -2,11 +2,13 @@
 //! [`photometric`] is the inner loop on its own (a field against posed views);
 //! [`init`] seeds a state's field from its depth maps; [`reconstruct`] is the paper's
 //! reconstruction phase per state (densify, prune, anneal, harden, part-aware remeshing,
-//! recovery). The articulation phase builds on its result.
+//! recovery). [`articulate`] is the articulation phase on its frozen meshes, [`object`] both
+//! phases on one object; [`observer`] is how a driver hears, previews, pauses and cancels them.
 
 pub mod articulate;
 pub mod init;
 pub mod object;
+pub mod observer;
 pub mod photometric;
 pub mod reconstruct;
 mod subdivide;

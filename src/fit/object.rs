@@ -5,7 +5,10 @@
 use serde::Serialize;
 
 use super::articulate::{Articulation, ArticulationConfig, articulate};
-use super::reconstruct::{Preset, Progress, Reconstruction, ReconstructionConfig, reconstruct};
+use super::observer::{Observer, Unobserved};
+use super::reconstruct::{
+    Phase, Preset, Progress, Reconstruction, ReconstructionConfig, reconstruct,
+};
 use crate::data::{Dataset, GroundTruth, JointKind, State};
 use crate::eval::{EvalError, EvalOptions, ObjectMetrics, evaluate_object};
 use crate::gpu::{GpuContext, GpuResult};
@@ -24,6 +27,57 @@ impl FitConfig {
             reconstruction: ReconstructionConfig::preset(preset),
             articulation: ArticulationConfig::preset(preset),
         }
+    }
+
+    /// How a demo captures its procedural object for this budget: square images at the
+    /// reconstruction's working size (32 to 512 px) and as many training views per state as it
+    /// uses (4 to 100), no test views. The CLI's and the page's demos share it.
+    pub fn demo_capture(&self, seed: u64) -> crate::render::RenderSpec {
+        let size = self.reconstruction.max_size.clamp(32, 512);
+        crate::render::RenderSpec {
+            width: size,
+            height: size,
+            train_views: self.reconstruction.max_views.clamp(4, 100),
+            test_views: 0,
+            seed,
+            ..crate::render::RenderSpec::default()
+        }
+    }
+
+    /// The fraction (0 to 1) of the whole fit done at `event`, counting optimisation steps:
+    /// each state's optimise + recover iterations, then the articulation iterations.
+    pub fn fraction_done(&self, event: &Progress) -> f64 {
+        let rec = &self.reconstruction;
+        let (fit, recover) = (rec.fit.iterations, rec.recovery_iterations);
+        let per_state = f64::from(fit + recover);
+        let art = self.articulation.iterations;
+        let decide = (art as f32 * self.articulation.decide_at) as u32;
+        let total = 2.0 * per_state + f64::from(art);
+        let done = if event.phase.is_articulation()
+            || event.phase == Phase::Done && event.state == State::End && event.iterations > 0
+        {
+            2.0 * per_state
+                + f64::from(match event.phase {
+                    Phase::Candidates => event.iteration,
+                    Phase::BakeOff => decide,
+                    _ => decide + event.iteration,
+                })
+        } else {
+            let state = if event.state == State::End {
+                per_state
+            } else {
+                0.0
+            };
+            state
+                + f64::from(match event.phase {
+                    Phase::Initialise => 0,
+                    Phase::Optimise | Phase::Densify => event.iteration,
+                    Phase::Remesh => fit,
+                    Phase::Recover => fit + event.iteration,
+                    _ => fit + recover,
+                })
+        };
+        (done / total.max(1.0)).clamp(0.0, 1.0)
     }
 }
 
@@ -117,20 +171,21 @@ impl ObjectFit {
     }
 }
 
-/// Fits `dataset`: reconstruction of both states, then articulation; `progress` hears both.
+/// Fits `dataset`: reconstruction of both states, then articulation; `observer` hears both
+/// and may pause or cancel them.
 pub async fn fit_object(
     ctx: &GpuContext,
     dataset: &Dataset,
     config: &FitConfig,
-    progress: &mut dyn FnMut(&Progress),
+    observer: &mut dyn Observer,
 ) -> GpuResult<ObjectFit> {
-    let reconstruction = reconstruct(ctx, dataset, &config.reconstruction, progress).await?;
+    let reconstruction = reconstruct(ctx, dataset, &config.reconstruction, observer).await?;
     let articulation = articulate(
         ctx,
         dataset,
         &reconstruction,
         &config.articulation,
-        progress,
+        observer,
     )
     .await?;
     Ok(ObjectFit {
@@ -155,18 +210,12 @@ pub async fn tiny_fit(
         movable_parts: Some(movable_parts),
         seed,
     })?;
-    let mut spec = crate::render::RenderSpec {
-        width: 32,
-        height: 32,
-        train_views: 4,
-        test_views: 0,
-        seed,
-        ..crate::render::RenderSpec::default()
-    };
+    let config = FitConfig::preset(Preset::Tiny);
+    let mut spec = config.demo_capture(seed);
     spec_edit(&mut spec);
-    let mut dataset = crate::render::capture_dataset(ctx, &object, &spec).await?;
+    let mut dataset = crate::render::capture_dataset(ctx, &object, &spec, &mut |_| {}).await?;
     edit(&mut dataset);
-    let fit = fit_object(ctx, &dataset, &FitConfig::preset(Preset::Tiny), &mut |_| {})
+    let fit = fit_object(ctx, &dataset, &config, &mut Unobserved)
         .await
         .map_err(|e| e.to_string())?;
     Ok((dataset, fit))

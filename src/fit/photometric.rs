@@ -10,6 +10,7 @@
 use glam::Vec3;
 use serde::Serialize;
 
+use super::observer::Preview;
 use super::subdivide::{subdivide_to_edge, weld};
 use super::views::ViewCycle;
 use crate::data::{Camera, Frame, Split, State};
@@ -229,6 +230,14 @@ pub(crate) fn target_rgb(frame: &Frame, background: Vec3) -> Vec<f32> {
     out
 }
 
+/// Channel planes (all R, then all G, then all B; values in [0, 1]) as interleaved RGB8.
+fn planes_to_rgb8(planes: &[f32]) -> Vec<u8> {
+    let n = planes.len() / 3;
+    (0..3 * n)
+        .map(|i| (planes[(i % 3) * n + i / 3].clamp(0.0, 1.0) * 255.0).round() as u8)
+        .collect()
+}
+
 /// Records the image loss of `state`'s last render against target view `view` and the
 /// rasterizer's backward pass, which leaves the gradients in `field`'s gradient buffers.
 #[allow(clippy::too_many_arguments)]
@@ -383,6 +392,36 @@ impl<'a> Trainer<'a> {
             );
         }
         Ok(sum / self.cameras.len().max(1) as f64)
+    }
+
+    /// The current render of training view `view` and its target (composited on the
+    /// background), as RGB8, for a [`Preview`]; the preview's state and iteration are left for
+    /// the caller to fill in.
+    pub async fn preview(
+        &mut self,
+        ctx: &GpuContext,
+        view: usize,
+        settings: &RasterSettings,
+    ) -> GpuResult<Preview> {
+        let (Some(camera), Some(frame)) = (self.cameras.get(view), self.frames.get(view)) else {
+            return Err(GpuError::InvalidInput(format!(
+                "no training view {view} to preview"
+            )));
+        };
+        self.raster
+            .forward(ctx, &self.field, &mut self.state, camera, settings)
+            .await?;
+        let render = self.state.read_render(ctx).await?;
+        let n = (render.width * render.height) as usize;
+        Ok(Preview {
+            state: State::Start,
+            view,
+            iteration: 0,
+            width: render.width,
+            height: render.height,
+            render: planes_to_rgb8(&render.planes[..3 * n]),
+            target: planes_to_rgb8(&target_rgb(frame, settings.background)),
+        })
     }
 
     /// Runs `config`'s whole schedule (γ, opacity floor, SH degree, decaying position rate) on
@@ -584,7 +623,7 @@ pub async fn synthetic_scene(ctx: &GpuContext, spec: &SceneSpec) -> Result<Probl
         seed: spec.seed,
         ..RenderSpec::default()
     };
-    let dataset = crate::render::capture_dataset(ctx, &object, &render).await?;
+    let dataset = crate::render::capture_dataset(ctx, &object, &render, &mut |_| {}).await?;
     let frames = dataset
         .views(State::Start, Split::Train)
         .map(|v| v.frames.clone())
@@ -701,12 +740,10 @@ pub async fn preview(
             columns.push(state.read_render(ctx).await?.planes[..3 * n].to_vec());
         }
         for (col, planes) in columns.iter().enumerate() {
-            for i in 0..n {
+            for (i, rgb) in planes_to_rgb8(planes).chunks_exact(3).enumerate() {
                 let (x, y) = (col as u32 * w + i as u32 % w, row as u32 * h + i as u32 / w);
                 let out = ((y * sheet_w + x) * 3) as usize;
-                for c in 0..3 {
-                    pixels[out + c] = (planes[c * n + i].clamp(0.0, 1.0) * 255.0).round() as u8;
-                }
+                pixels[out..out + 3].copy_from_slice(rgb);
             }
         }
     }

@@ -18,6 +18,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::init::{InitOptions, initial_field};
+use super::observer::{Observer, Preview, checkpoint};
 use super::photometric::{CurvePoint, PhotometricConfig, Trainer};
 use super::views::downsample_frame;
 use crate::data::{Camera, Dataset, Frame, GroundTruth, GtMeshes, Split, State, TriMesh};
@@ -29,7 +30,7 @@ use crate::mesh::topology::{
 use crate::mesh::{
     RemeshOptions, harden_parts, part_aware_remesh, part_meshes, restricted_delaunay,
 };
-use crate::raster::MeshField;
+use crate::raster::{MeshField, RasterSettings};
 
 /// Named budgets: `tiny` for tests, `fast` for the CPU demo, `paper` for the paper's setting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -286,6 +287,16 @@ impl Phase {
         matches!(self, Phase::Candidates | Phase::BakeOff | Phase::Refine)
     }
 
+    /// The step of the method this phase belongs to, in the paper's words.
+    pub fn stage(self) -> &'static str {
+        match self {
+            Phase::Remesh => "remeshing",
+            Phase::Candidates | Phase::Refine => "articulation",
+            Phase::BakeOff => "bake-off decision",
+            _ => "reconstruction",
+        }
+    }
+
     pub fn name(self) -> &'static str {
         match self {
             Phase::Initialise => "initialise",
@@ -483,13 +494,13 @@ pub async fn reconstruct(
     ctx: &GpuContext,
     dataset: &Dataset,
     config: &ReconstructionConfig,
-    progress: &mut dyn FnMut(&Progress),
+    observer: &mut dyn Observer,
 ) -> GpuResult<Reconstruction> {
     let mut states = Vec::new();
     for state in [State::Start, State::End] {
         let frames = training_views(dataset, state, config).map_err(GpuError::InvalidInput)?;
         states.push(
-            reconstruct_state(ctx, state, &frames, dataset.num_parts, config, progress).await?,
+            reconstruct_state(ctx, state, &frames, dataset.num_parts, config, observer).await?,
         );
     }
     Ok(Reconstruction {
@@ -637,6 +648,27 @@ fn remesh(field: &MeshField, config: &ReconstructionConfig) -> (MeshField, Remes
     (out, stats)
 }
 
+/// A training checkpoint: reports `event`, then renders training view 0 for the observer when it
+/// asks for a preview.
+async fn watch(
+    ctx: &GpuContext,
+    observer: &mut dyn Observer,
+    trainer: &mut Trainer<'_>,
+    event: &Progress,
+    settings: &RasterSettings,
+) -> GpuResult<()> {
+    checkpoint(observer, event).await?;
+    if observer.wants_preview() {
+        let preview = trainer.preview(ctx, 0, settings).await?;
+        observer.preview(Preview {
+            state: event.state,
+            iteration: event.iteration,
+            ..preview
+        });
+    }
+    Ok(())
+}
+
 /// Reconstructs one state from its training `frames` (see the module docs).
 pub async fn reconstruct_state(
     ctx: &GpuContext,
@@ -644,7 +676,7 @@ pub async fn reconstruct_state(
     frames: &[Frame],
     num_parts: usize,
     config: &ReconstructionConfig,
-    progress: &mut dyn FnMut(&Progress),
+    observer: &mut dyn Observer,
 ) -> GpuResult<StateReconstruction> {
     let t0 = now_seconds();
     let mut times = PhaseTimes::default();
@@ -682,14 +714,18 @@ pub async fn reconstruct_state(
     let initial_faces = field.faces.len();
     let px_per_m = pixels_per_metre(&field, &cameras);
     times.initialise_s = lap();
-    progress(&event(
-        Phase::Initialise,
-        0,
-        0,
-        None,
-        None,
-        (field.num_vertices(), field.faces.len()),
-    ));
+    checkpoint(
+        observer,
+        &event(
+            Phase::Initialise,
+            0,
+            0,
+            None,
+            None,
+            (field.num_vertices(), field.faces.len()),
+        ),
+    )
+    .await?;
 
     // Optimisation with densification and pruning.
     let fit = &config.fit;
@@ -717,14 +753,15 @@ pub async fn reconstruct_state(
         trainer.step(ctx, &settings, &fit.weights).await?;
         if let Some(point) = fit.report(ctx, &mut trainer, i, &settings).await? {
             times.optimise_s += lap();
-            progress(&event(
+            let at = event(
                 Phase::Optimise,
                 i + 1,
                 fit.iterations,
                 Some(point.loss.total),
                 point.psnr,
                 sizes,
-            ));
+            );
+            watch(ctx, observer, &mut trainer, &at, &settings).await?;
             curve.push(point);
         }
         if i > 0 && i % every == 0 {
@@ -745,14 +782,8 @@ pub async fn reconstruct_state(
                 faces_pruned += pruned;
                 sizes = (edited.num_vertices(), edited.faces.len());
                 times.densify_s += lap();
-                progress(&event(
-                    Phase::Densify,
-                    i + 1,
-                    fit.iterations,
-                    None,
-                    None,
-                    sizes,
-                ));
+                let at = event(Phase::Densify, i + 1, fit.iterations, None, None, sizes);
+                checkpoint(observer, &at).await?;
             }
             trainer.clear_face_stats(ctx);
         }
@@ -774,7 +805,7 @@ pub async fn reconstruct_state(
     }
     sizes = (remeshed.num_vertices(), remeshed.faces.len());
     times.remesh_s = lap();
-    progress(&event(Phase::Remesh, 0, 0, None, None, sizes));
+    checkpoint(observer, &event(Phase::Remesh, 0, 0, None, None, sizes)).await?;
 
     // Recovery with fixed topology.
     let recovery = config.recovery();
@@ -786,18 +817,23 @@ pub async fn reconstruct_state(
     )?;
     let psnr_remeshed = trainer.mean_psnr(ctx, &recovery.settings_at(0)).await?;
     times.measure_s += lap();
-    trainer
-        .run(ctx, &recovery, &mut |point| {
-            progress(&event(
+    let decay = recovery.position_decay();
+    for i in 0..recovery.iterations {
+        let settings = recovery.settings_at(i);
+        trainer.optimizer().set_position_lr(decay.lr(i));
+        trainer.step(ctx, &settings, &recovery.weights).await?;
+        if let Some(point) = recovery.report(ctx, &mut trainer, i, &settings).await? {
+            let at = event(
                 Phase::Recover,
-                point.iteration + 1,
+                i + 1,
                 recovery.iterations,
                 Some(point.loss.total),
                 point.psnr,
                 sizes,
-            ))
-        })
-        .await?;
+            );
+            watch(ctx, observer, &mut trainer, &at, &settings).await?;
+        }
+    }
     times.recover_s = lap();
     let psnr_recovered = trainer
         .mean_psnr(ctx, &recovery.settings_at(recovery.iterations))
@@ -808,7 +844,11 @@ pub async fn reconstruct_state(
     let parts = harden_parts(&field);
     let meshes = part_meshes(&field.positions, &field.faces, &parts, num_parts);
     times.total_s = now_seconds() - t0;
-    progress(&event(Phase::Done, 0, 0, None, Some(psnr_recovered), sizes));
+    checkpoint(
+        observer,
+        &event(Phase::Done, 0, 0, None, Some(psnr_recovered), sizes),
+    )
+    .await?;
     Ok(StateReconstruction {
         state,
         field,

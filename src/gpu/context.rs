@@ -41,6 +41,9 @@ pub enum GpuError {
     /// A kernel's inputs do not fit together (sizes, indices, counts); the message says which and how.
     #[error("{0}")]
     InvalidInput(String),
+    /// The driver cancelled the fit at a checkpoint ([`crate::fit::observer::Command::Cancel`]).
+    #[error("cancelled: the fit was stopped before it finished")]
+    Cancelled,
 }
 
 impl GpuError {
@@ -72,6 +75,8 @@ pub struct AdapterReport {
 
 /// A device and queue with the adapter's own limits, plus captured errors.
 pub struct GpuContext {
+    /// The instance the adapter came from (the page's viewer makes its canvas surface with it).
+    pub instance: wgpu::Instance,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub adapter: AdapterReport,
@@ -154,6 +159,7 @@ impl GpuContext {
             max_storage_buffers_per_shader_stage: limits.max_storage_buffers_per_shader_stage,
         };
         Ok(Self {
+            instance,
             device,
             queue,
             dispatch_dim_limit: limits.max_compute_workgroups_per_dimension.max(1),

@@ -19,7 +19,7 @@ mod scan;
 pub mod selftest;
 
 pub use buffers::binding_chunks;
-pub use clock::now_seconds;
+pub use clock::{now_seconds, sleep_ms};
 pub use context::{AdapterReport, GpuContext, GpuError};
 pub use fma::{FmaPeak, fma_peak, fma_peak_with_clock};
 pub(crate) use kernel::compute_pass;

@@ -273,11 +273,12 @@ pub struct RenderProgress {
 }
 
 /// Renders the two-state dataset of `obj` in memory and reads it back as a [`Dataset`] (what a
-/// user would drop in), for tests and the browser demo.
+/// user would drop in), for tests and the demos; `progress` hears about every frame.
 pub async fn capture_dataset(
     ctx: &GpuContext,
     obj: &ArticulatedObject,
     spec: &RenderSpec,
+    progress: &mut dyn FnMut(RenderProgress),
 ) -> Result<crate::data::Dataset, String> {
     let mut files = FileSet::new();
     render_dataset(
@@ -288,7 +289,7 @@ pub async fn capture_dataset(
             files.extend(batch);
             Ok(())
         },
-        &mut |_| {},
+        progress,
     )
     .await
     .map_err(|e| e.to_string())?;

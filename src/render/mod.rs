@@ -11,7 +11,8 @@
 //!   and more are **clamped** to 65 535 mm. [`RenderedView::depth_metres`] keeps the unrounded values.
 //! - The depth buffer uses reversed z (`Depth32Float`, near → 1, far → 0, compare `Greater`) with near/far
 //!   fitted to the scene's vertices for every view; it only decides visibility.
-//! - Shading is deterministic: base colour (× texture, bilinear, repeat) × (0.3 ambient + 0.7 two-sided Lambert
+//! - Shading is deterministic: base colour (the mesh's vertex colours when it has them, else its material's;
+//!   × texture, bilinear, repeat) × (0.3 ambient + 0.7 two-sided Lambert
 //!   from a headlight at the camera), written sRGB-encoded to `Rgba8Unorm`. Material alpha is ignored: every
 //!   surface is opaque. Background is transparent black, part id −1.
 //! - No back-face culling: imported meshes do not always wind consistently.
@@ -20,6 +21,7 @@
 
 mod dataset;
 mod sheet;
+pub mod viewer;
 
 pub use dataset::{
     CaptureTruth, DatasetRenderError, MIN_OBJECT_SIZE, ObjectProblem, RenderProgress, RenderSpec,
@@ -85,20 +87,23 @@ struct FrameParams {
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct MeshParams {
-    base_color: [f32; 4],
     part: i32,
     textured: u32,
     _pad: [u32; 2],
 }
+const _: () = assert!(size_of::<MeshParams>() == 16);
 
-/// Interleaved vertex: position, normal, uv.
+/// Interleaved vertex: position, normal, uv, linear base colour (the mesh's vertex colours, or
+/// its material's colour on every vertex).
 #[repr(C)]
 #[derive(Clone, Copy, Pod, Zeroable)]
 struct Vertex {
     position: [f32; 3],
     normal: [f32; 3],
     uv: [f32; 2],
+    color: [f32; 3],
 }
+const _: () = assert!(size_of::<Vertex>() == 44);
 
 /// Renders colour, z-depth and part ids at a fixed image size; reusable across views and scenes.
 pub struct GtRenderer {
@@ -197,7 +202,7 @@ impl GtRenderer {
             bind_group_layouts: &[Some(&frame_layout), Some(&mesh_layout)],
             immediate_size: 0,
         });
-        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2];
+        let attributes = wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32x2, 3 => Float32x3];
         let pipeline = device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
             label: Some("render_gt"),
             layout: Some(&layout),
@@ -313,6 +318,50 @@ impl GtRenderer {
         meshes: &[PartMesh],
         camera: &Camera,
     ) -> GpuResult<RenderedView> {
+        let color = self.color.create_view(&Default::default());
+        let mut encoder = self.encode(ctx, meshes, camera, &color, wgpu::Color::TRANSPARENT)?;
+        let region = self.padded_row as u64 * self.height as u64;
+        for (k, texture) in [&self.color, &self.depth, &self.part]
+            .into_iter()
+            .enumerate()
+        {
+            encoder.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &self.readback,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: k as u64 * region,
+                        bytes_per_row: Some(self.padded_row),
+                        rows_per_image: Some(self.height),
+                    },
+                },
+                wgpu::Extent3d {
+                    width: self.width,
+                    height: self.height,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let bytes: Vec<u8> = ctx.read_buffer(&self.readback, 3 * region as usize).await?;
+        Ok(self.unpack(&bytes))
+    }
+
+    /// Uploads `meshes` and records their render pass into `color` (the depth and part ids go
+    /// to the renderer's own targets).
+    fn encode(
+        &self,
+        ctx: &GpuContext,
+        meshes: &[PartMesh],
+        camera: &Camera,
+        color: &wgpu::TextureView,
+        background: wgpu::Color,
+    ) -> GpuResult<wgpu::CommandEncoder> {
         let k = camera.intrinsics;
         if (k.width, k.height) != (self.width, self.height) {
             return Err(invalid(format!(
@@ -391,9 +440,7 @@ impl GtRenderer {
                 },
                 _ => &self.white,
             };
-            let c = m.material.base_color;
             let params = MeshParams {
-                base_color: c.map(|v| if v.is_finite() { v } else { 0.0 }),
                 part: pm.part.into(),
                 textured: textured as u32,
                 _pad: [0; 2],
@@ -420,8 +467,7 @@ impl GtRenderer {
             draws.push((vertex_buffer, index_buffer, index_count as u32, group));
         }
 
-        let views =
-            [&self.color, &self.depth, &self.part].map(|t| t.create_view(&Default::default()));
+        let views = [&self.depth, &self.part].map(|t| t.create_view(&Default::default()));
         let zview = self.zbuffer.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         {
@@ -439,11 +485,11 @@ impl GtRenderer {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("render_gt"),
                 color_attachments: &[
+                    clear(color, background),
                     clear(&views[0], wgpu::Color::TRANSPARENT),
-                    clear(&views[1], wgpu::Color::TRANSPARENT),
                     // Integer targets take the clear value's red channel as the integer: background −1.
                     clear(
-                        &views[2],
+                        &views[1],
                         wgpu::Color {
                             r: -1.0,
                             g: 0.0,
@@ -474,36 +520,7 @@ impl GtRenderer {
                 pass.draw_indexed(0..*count, 0, 0..1);
             }
         }
-        let region = self.padded_row as u64 * self.height as u64;
-        for (k, texture) in [&self.color, &self.depth, &self.part]
-            .into_iter()
-            .enumerate()
-        {
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &self.readback,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: k as u64 * region,
-                        bytes_per_row: Some(self.padded_row),
-                        rows_per_image: Some(self.height),
-                    },
-                },
-                wgpu::Extent3d {
-                    width: self.width,
-                    height: self.height,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
-        ctx.queue.submit([encoder.finish()]);
-        let bytes: Vec<u8> = ctx.read_buffer(&self.readback, 3 * region as usize).await?;
-        Ok(self.unpack(&bytes))
+        Ok(encoder)
     }
 
     /// Strips the row padding of the three read-back targets and converts them to the output images.
@@ -576,6 +593,9 @@ fn vertices_of(i: usize, m: &RenderMesh) -> GpuResult<Vec<Vertex>> {
         )));
     }
     let uvs = m.uvs.as_deref().unwrap_or(&[]);
+    let colors = m.colors.as_deref().unwrap_or(&[]);
+    let finite = |c: [f32; 3]| c.map(|v| if v.is_finite() { v } else { 0.0 });
+    let material = finite([0, 1, 2].map(|k| m.material.base_color[k]));
     Ok(m.positions
         .iter()
         .enumerate()
@@ -583,6 +603,7 @@ fn vertices_of(i: usize, m: &RenderMesh) -> GpuResult<Vec<Vertex>> {
             position: p.to_array(),
             normal: m.normals.get(v).map_or([0.0; 3], |n| n.to_array()),
             uv: uvs.get(v).map_or([0.0; 2], |t| t.to_array()),
+            color: colors.get(v).map_or(material, |&c| finite(c)),
         })
         .collect())
 }

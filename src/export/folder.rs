@@ -1,0 +1,85 @@
+//! Everything one fit leaves behind, as files: what `artmesh fit` writes to its folder and what
+//! the page offers for download. One builder serves both, so the two always agree.
+
+use serde::Serialize;
+
+use super::{JOINTS_FILE, Twin, export_twin};
+use crate::data::{Dataset, FileSet};
+use crate::eval::{ChamferOptions, EvalOptions, ObjectMetrics, reconstruction_report};
+use crate::fit::object::{FitConfig, JointRecord, ObjectFit};
+
+/// The fit report's path in a fit folder.
+pub const REPORT_FILE: &str = "report.json";
+
+/// A fit's results and its folder's files.
+#[derive(Debug, Clone)]
+pub struct FitFolder {
+    /// `report.json`: the configuration, joints, warnings, curves, reconstruction quality and,
+    /// with ground truth, the metrics.
+    pub report: serde_json::Value,
+    pub joints: Vec<JointRecord>,
+    /// The scores against the dataset's ground truth, when it has GT joints.
+    pub metrics: Option<ObjectMetrics>,
+    /// `joints.json`, `report.json`, the predicted `gt/` folder and the twin's exports
+    /// ([`super::TwinFiles::into_fit_folder`]).
+    pub files: FileSet,
+    /// The twin the exports were written from.
+    pub twin: Twin,
+}
+
+fn json(value: &impl Serialize, what: &str) -> Result<String, String> {
+    serde_json::to_string_pretty(value).map_err(|e| format!("{what}: cannot serialise: {e}"))
+}
+
+impl FitFolder {
+    /// Scores and exports `fit` of `dataset` (object `id` of `category`), which took `seconds`.
+    /// Errors say which step failed.
+    pub fn build(
+        fit: &ObjectFit,
+        dataset: &Dataset,
+        config: &FitConfig,
+        id: &str,
+        category: &str,
+        seconds: f64,
+    ) -> Result<FitFolder, String> {
+        let quality = reconstruction_report(
+            &fit.reconstruction,
+            &dataset.gt_meshes,
+            &ChamferOptions::default(),
+        );
+        let metrics = fit
+            .evaluate(dataset, id, category, &EvalOptions::default())
+            .transpose()
+            .map_err(|e| format!("{id}: scoring against the ground truth: {e}"))?;
+        let joints = fit.joint_records();
+        let report = serde_json::json!({
+            "id": id,
+            "seconds": seconds,
+            "config": config,
+            "joints": joints,
+            "warnings": fit.articulation.warnings,
+            "articulation": {
+                "times": fit.articulation.times,
+                "curve": fit.articulation.curve,
+                "fitted": fit.articulation.joints,
+            },
+            "reconstruction": quality,
+            "metrics": metrics,
+        });
+        let joints_json = json(&joints, JOINTS_FILE)?.into_bytes();
+        let twin = Twin::from_fit(fit, id).map_err(|e| format!("{id}: {e}"))?;
+        let exports = export_twin(&twin.object(), &twin.end_configuration(), &joints_json)
+            .map_err(|e| format!("{id}: exporting: {e}"))?;
+        let mut files = fit.as_ground_truth().to_files();
+        files.insert(JOINTS_FILE.into(), joints_json);
+        files.insert(REPORT_FILE.into(), json(&report, REPORT_FILE)?.into_bytes());
+        files.extend(exports.into_fit_folder());
+        Ok(FitFolder {
+            report,
+            joints,
+            metrics,
+            files,
+            twin,
+        })
+    }
+}

@@ -1,0 +1,92 @@
+//! Who watches a fit. The driver (the CLI's progress bar, the page, a test) hears the fit's
+//! progress events, may ask for a preview render of the state being reconstructed, and steers the
+//! fit (run, pause, cancel) at checkpoints between GPU submissions. In the browser a checkpoint
+//! is also where the fit hands the event loop a turn, so the page stays responsive.
+
+use super::reconstruct::Progress;
+use crate::data::State;
+use crate::gpu::{GpuError, GpuResult, sleep_ms};
+
+/// What the driver wants the fit to do next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Command {
+    Run,
+    /// Wait at the checkpoint, asking again every [`PAUSE_POLL_MS`].
+    Pause,
+    /// Stop: the fit returns [`GpuError::Cancelled`].
+    Cancel,
+}
+
+/// How often a paused fit asks whether to go on.
+pub const PAUSE_POLL_MS: u32 = 100;
+
+/// A render of one training view beside its ground truth, both RGB8 row-major.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Preview {
+    pub state: State,
+    /// Training view index and the iteration the render was taken at.
+    pub view: usize,
+    pub iteration: u32,
+    pub width: u32,
+    pub height: u32,
+    pub render: Vec<u8>,
+    pub target: Vec<u8>,
+}
+
+/// The audience of a fit. Any `FnMut(&Progress)` closure is one that only listens.
+pub trait Observer {
+    /// Hears every progress event.
+    fn progress(&mut self, event: &Progress);
+    /// Asked at reconstruction checkpoints; `true` makes the fit render a [`Preview`] there.
+    fn wants_preview(&mut self) -> bool {
+        false
+    }
+    /// Receives the preview asked for.
+    fn preview(&mut self, _preview: Preview) {}
+    /// Asked at every checkpoint.
+    fn command(&mut self) -> Command {
+        Command::Run
+    }
+}
+
+impl<F: FnMut(&Progress)> Observer for F {
+    fn progress(&mut self, event: &Progress) {
+        self(event)
+    }
+}
+
+/// An observer that ignores everything (benchmarks, tests that only want the result).
+pub struct Unobserved;
+
+impl Observer for Unobserved {
+    fn progress(&mut self, _event: &Progress) {}
+}
+
+/// Seconds of work between two turns of the browser's event loop.
+#[cfg(target_arch = "wasm32")]
+const YIELD_EVERY_S: f64 = 0.03;
+
+/// Reports `event`, then obeys the observer: returns on [`Command::Run`], waits while paused and
+/// fails with [`GpuError::Cancelled`] on cancel. In the browser it also yields to the event loop
+/// when the fit has held it for more than [`YIELD_EVERY_S`].
+pub async fn checkpoint(observer: &mut dyn Observer, event: &Progress) -> GpuResult<()> {
+    observer.progress(event);
+    loop {
+        match observer.command() {
+            Command::Run => break,
+            Command::Cancel => return Err(GpuError::Cancelled),
+            Command::Pause => sleep_ms(PAUSE_POLL_MS).await,
+        }
+    }
+    #[cfg(target_arch = "wasm32")]
+    {
+        use std::cell::Cell;
+        thread_local!(static LAST_YIELD: Cell<f64> = const { Cell::new(0.0) });
+        let now = crate::gpu::now_seconds();
+        if now - LAST_YIELD.get() > YIELD_EVERY_S {
+            sleep_ms(0).await;
+            LAST_YIELD.set(crate::gpu::now_seconds());
+        }
+    }
+    Ok(())
+}

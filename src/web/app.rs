@@ -1,0 +1,377 @@
+//! The page's main job: a dataset (dropped, zipped, or the demo's procedural capture), its fit
+//! with progress events, previews and pause/cancel, and the fit's files for download. Each step
+//! is the crate's own code, the same the CLI runs; this file only converts at the boundary.
+
+use std::rc::Rc;
+
+use js_sys::{Array, Function, Object, Reflect, Uint8ClampedArray};
+use wasm_bindgen::prelude::*;
+
+use super::{context, file_set, js_error};
+use crate::data::{Dataset, FileSet, Split, State, read_zip, rebase_on_dataset_root};
+use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
+use crate::fit::object::{FitConfig, fit_object};
+use crate::fit::observer::{Command, Observer, Preview};
+use crate::fit::reconstruct::{Preset, Progress};
+use crate::gpu::now_seconds;
+use crate::synth::{Category, SynthParams, generate};
+
+/// Seconds between two previews the page is sent.
+const PREVIEW_EVERY_S: f64 = 1.5;
+
+/// A plain JS object from key/value pairs.
+fn object(pairs: &[(&str, JsValue)]) -> JsValue {
+    let o = Object::new();
+    for (k, v) in pairs {
+        let _ = Reflect::set(&o, &JsValue::from_str(k), v);
+    }
+    o.into()
+}
+
+fn number(v: impl Into<f64>) -> JsValue {
+    JsValue::from_f64(v.into())
+}
+
+/// RGB8 or RGBA8 pixels as the RGBA `Uint8ClampedArray` an `ImageData` takes.
+fn rgba_array(pixels: &[u8], channels: usize) -> Uint8ClampedArray {
+    let rgba: Vec<u8> = if channels == 4 {
+        pixels.to_vec()
+    } else {
+        pixels
+            .chunks_exact(3)
+            .flat_map(|c| [c[0], c[1], c[2], 255])
+            .collect()
+    };
+    Uint8ClampedArray::from(rgba.as_slice())
+}
+
+/// The demo's choices as JSON: categories with their part counts, presets, defaults.
+#[wasm_bindgen]
+pub fn catalogue() -> String {
+    let categories: Vec<_> = Category::ALL
+        .iter()
+        .map(|c| {
+            let parts = c.movable_parts();
+            serde_json::json!({
+                "name": c.slug(),
+                "label": c.name(),
+                "parts": [parts.start(), parts.end()],
+                "default_parts": 2.clamp(*parts.start(), *parts.end()),
+            })
+        })
+        .collect();
+    let presets: Vec<_> = [Preset::Tiny, Preset::Fast, Preset::Paper]
+        .into_iter()
+        .map(|p| {
+            let c = FitConfig::preset(p);
+            let rec = &c.reconstruction;
+            let size = if rec.max_size == 0 {
+                "full-size".to_string()
+            } else {
+                format!("{} px", rec.max_size)
+            };
+            serde_json::json!({
+                "name": p.name(),
+                "about": format!(
+                    "{size}, {} iterations per state + {} for the joints",
+                    rec.fit.iterations + rec.recovery_iterations,
+                    c.articulation.iterations
+                ),
+            })
+        })
+        .collect();
+    serde_json::json!({
+        "categories": categories,
+        "presets": presets,
+        "default": {"category": Category::StorageFurniture.slug(), "parts": 2, "preset": "fast", "seed": 0},
+    })
+    .to_string()
+}
+
+struct Loaded {
+    dataset: Dataset,
+    /// Used as the fit's id and the twin's name.
+    name: String,
+    /// The synthetic category, or "unknown" for user data (a label in the metrics).
+    category: String,
+}
+
+/// A validated dataset held in wasm memory.
+#[wasm_bindgen(js_name = Dataset)]
+pub struct WebDataset(Rc<Loaded>);
+
+fn dataset_from(files: &FileSet, name: String) -> Result<WebDataset, JsError> {
+    let dataset = Dataset::from_files(files).map_err(|problems| {
+        let lines: Vec<String> = problems.0.iter().map(ToString::to_string).collect();
+        JsError::new(&format!(
+            "{} problem(s) found:\n{}",
+            lines.len(),
+            lines.join("\n")
+        ))
+    })?;
+    Ok(WebDataset(Rc::new(Loaded {
+        dataset,
+        name,
+        category: "unknown".into(),
+    })))
+}
+
+#[wasm_bindgen(js_class = Dataset)]
+impl WebDataset {
+    /// A dataset from dropped files (`paths[i]` relative to the dataset folder holds
+    /// `contents[i]`), named `name`. Throws with every problem found, one per line.
+    pub fn from_files(
+        paths: Vec<String>,
+        contents: Vec<js_sys::Uint8Array>,
+        name: Option<String>,
+    ) -> Result<WebDataset, JsError> {
+        let files = rebase_on_dataset_root(file_set(paths, contents)?);
+        dataset_from(&files, name.unwrap_or_else(|| "dataset".into()))
+    }
+
+    /// A dataset from a `.zip` of its folder. Throws naming the archive or the files at fault.
+    pub fn from_zip(file_name: String, bytes: js_sys::Uint8Array) -> Result<WebDataset, JsError> {
+        let files = read_zip(&file_name, &bytes.to_vec()).map_err(js_error)?;
+        let stem = file_name.trim_end_matches(".zip").to_string();
+        dataset_from(&files, stem)
+    }
+
+    /// Generates the procedural `category` object with `parts` movable parts from `seed` and
+    /// captures both states as the `preset`'s demo does (`artmesh demo`); `on_progress` hears
+    /// `{done, total}` views.
+    pub async fn demo(
+        category: String,
+        parts: u32,
+        preset: String,
+        seed: u32,
+        on_progress: Function,
+    ) -> Result<WebDataset, JsError> {
+        let category = Category::parse(&category).map_err(|e| JsError::new(&e))?;
+        let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
+        let object = generate(&SynthParams {
+            category,
+            movable_parts: Some(parts as usize),
+            seed: seed.into(),
+        })
+        .map_err(|e| JsError::new(&e))?;
+        let ctx = context().await?;
+        let dataset = crate::render::capture_dataset(
+            &ctx,
+            &object,
+            &config.demo_capture(seed.into()),
+            &mut |p| {
+                let ev = object_of_progress(p.done, p.total);
+                let _ = on_progress.call1(&JsValue::NULL, &ev);
+            },
+        )
+        .await
+        .map_err(|e| JsError::new(&format!("{}: {e}", object.name)))?;
+        Ok(WebDataset(Rc::new(Loaded {
+            dataset,
+            name: object.name.clone(),
+            category: category.name().into(),
+        })))
+    }
+
+    pub fn name(&self) -> String {
+        self.0.name.clone()
+    }
+
+    /// What `artmesh info` prints about it.
+    pub fn summary(&self) -> String {
+        self.0.dataset.summary().to_string()
+    }
+
+    pub fn summary_json(&self) -> Result<String, JsError> {
+        serde_json::to_string(&self.0.dataset.summary()).map_err(js_error)
+    }
+
+    /// The first `per_state` training images of each state:
+    /// `[{state, view, width, height, rgba}]`.
+    pub fn thumbnails(&self, per_state: u32) -> Array {
+        let out = Array::new();
+        for state in State::ALL {
+            let Some(views) = self.0.dataset.views(state, Split::Train) else {
+                continue;
+            };
+            for (i, frame) in views.frames.iter().take(per_state as usize).enumerate() {
+                let img = &frame.rgba;
+                out.push(&object(&[
+                    ("state", JsValue::from_str(state.name())),
+                    ("view", number(i as u32)),
+                    ("width", number(img.width)),
+                    ("height", number(img.height)),
+                    ("rgba", rgba_array(&img.pixels, 4).into()),
+                ]));
+            }
+        }
+        out
+    }
+
+    /// Another handle to the same dataset (`fit` consumes the handle it is given).
+    pub fn share(&self) -> WebDataset {
+        WebDataset(self.0.clone())
+    }
+}
+
+fn object_of_progress(done: usize, total: usize) -> JsValue {
+    object(&[
+        ("done", number(done as u32)),
+        ("total", number(total as u32)),
+    ])
+}
+
+/// The page as a fit's observer: events and previews go to `on_event`, `control()` is asked
+/// for "run" / "pause" / "cancel" at every checkpoint.
+struct PageObserver {
+    config: FitConfig,
+    on_event: Function,
+    control: Function,
+    t0: f64,
+    last_preview: Option<f64>,
+}
+
+impl PageObserver {
+    fn send(&self, event: &JsValue) {
+        let _ = self.on_event.call1(&JsValue::NULL, event);
+    }
+}
+
+impl Observer for PageObserver {
+    fn progress(&mut self, e: &Progress) {
+        let elapsed = now_seconds() - self.t0;
+        let fraction = self.config.fraction_done(e);
+        let eta = (fraction > 0.02).then(|| elapsed * (1.0 - fraction) / fraction);
+        let state = if e.phase.is_articulation() {
+            "both"
+        } else {
+            e.state.name()
+        };
+        let opt = |v: Option<f64>| v.map_or(JsValue::NULL, JsValue::from_f64);
+        self.send(&object(&[
+            ("kind", "progress".into()),
+            ("state", state.into()),
+            ("phase", e.phase.name().into()),
+            ("stage", e.phase.stage().into()),
+            ("iteration", number(e.iteration)),
+            ("iterations", number(e.iterations)),
+            ("loss", opt(e.loss.map(f64::from))),
+            ("psnr", opt(e.psnr)),
+            ("vertices", number(e.vertices as u32)),
+            ("faces", number(e.faces as u32)),
+            ("elapsed_s", number(elapsed)),
+            ("fraction", number(fraction)),
+            ("eta_s", opt(eta)),
+        ]));
+    }
+
+    fn wants_preview(&mut self) -> bool {
+        let now = now_seconds();
+        let due = self.last_preview.is_none_or(|t| now - t >= PREVIEW_EVERY_S);
+        if due {
+            self.last_preview = Some(now);
+        }
+        due
+    }
+
+    fn preview(&mut self, p: Preview) {
+        self.send(&object(&[
+            ("kind", "preview".into()),
+            ("state", p.state.name().into()),
+            ("view", number(p.view as u32)),
+            ("iteration", number(p.iteration)),
+            ("width", number(p.width)),
+            ("height", number(p.height)),
+            ("render", rgba_array(&p.render, 3).into()),
+            ("target", rgba_array(&p.target, 3).into()),
+        ]));
+    }
+
+    fn command(&mut self) -> Command {
+        let answer = self.control.call0(&JsValue::NULL).ok();
+        match answer.and_then(|v| v.as_string()).as_deref() {
+            Some("pause") => Command::Pause,
+            Some("cancel") => Command::Cancel,
+            _ => Command::Run,
+        }
+    }
+}
+
+/// Fits `dataset` with `preset` on the page's GPU (reconstruction of both states, then
+/// articulation), telling `on_event` about progress and previews and asking `control` whether
+/// to go on. Rejects with a message starting "cancelled" when cancelled.
+#[wasm_bindgen]
+pub async fn fit(
+    dataset: WebDataset,
+    preset: String,
+    on_event: Function,
+    control: Function,
+) -> Result<FitResult, JsError> {
+    let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
+    let ctx = context().await?;
+    let loaded = dataset.0;
+    let mut observer = PageObserver {
+        config,
+        on_event,
+        control,
+        t0: now_seconds(),
+        last_preview: None,
+    };
+    let fit = fit_object(&ctx, &loaded.dataset, &config, &mut observer)
+        .await
+        .map_err(js_error)?;
+    let seconds = now_seconds() - observer.t0;
+    let folder = FitFolder::build(
+        &fit,
+        &loaded.dataset,
+        &config,
+        &loaded.name,
+        &loaded.category,
+        seconds,
+    )
+    .map_err(|e| JsError::new(&e))?;
+    Ok(FitResult(Rc::new(folder)))
+}
+
+/// A finished fit: its report, joints, twin and downloadable files.
+#[wasm_bindgen]
+pub struct FitResult(pub(super) Rc<FitFolder>);
+
+/// What the page offers for download.
+const DOWNLOADS: [&str; 4] = [GLB_FILE, ZIP_FILE, JOINTS_FILE, REPORT_FILE];
+
+#[wasm_bindgen]
+impl FitResult {
+    /// `report.json`.
+    pub fn report(&self) -> Result<String, JsError> {
+        serde_json::to_string(&self.0.report).map_err(js_error)
+    }
+
+    /// `joints.json`.
+    pub fn joints(&self) -> Result<String, JsError> {
+        serde_json::to_string(&self.0.joints).map_err(js_error)
+    }
+
+    /// The downloadable files' names.
+    pub fn file_names(&self) -> Vec<String> {
+        DOWNLOADS.iter().map(|s| s.to_string()).collect()
+    }
+
+    /// One downloadable file's bytes; throws for a name [`FitResult::file_names`] does not list.
+    pub fn file(&self, name: String) -> Result<js_sys::Uint8Array, JsError> {
+        match self.0.files.get(&name) {
+            Some(bytes) if DOWNLOADS.contains(&name.as_str()) => {
+                Ok(js_sys::Uint8Array::from(bytes.as_slice()))
+            }
+            _ => Err(JsError::new(&format!(
+                "no download named '{name}': expected one of {}",
+                DOWNLOADS.join(", ")
+            ))),
+        }
+    }
+
+    /// Another handle to the same result (the viewer consumes the handle it is given).
+    pub fn share(&self) -> FitResult {
+        FitResult(self.0.clone())
+    }
+}

@@ -1,0 +1,174 @@
+//! The result viewer: the fitted twin ([`TwinScene`]) rendered by the ground-truth renderer on
+//! the page's WebGPU device and shown on the page's canvas, redrawn when the page changes a
+//! joint, the state, the camera or the canvas size.
+//!
+//! The frame is read back and put on a 2-D canvas rather than presented through a WebGPU
+//! canvas context: in headless Chromium on SwiftShader (our CI browser) presenting to a
+//! configured `webgpu` canvas destroyed the device after the first frames (measured
+//! 2026-12-01), while the same renders read back work everywhere.
+
+use std::cell::{Cell, RefCell};
+use std::rc::Rc;
+
+use wasm_bindgen::prelude::*;
+
+use super::app::FitResult;
+use super::{context, js_error};
+use crate::gpu::GpuContext;
+use crate::render::GtRenderer;
+use crate::render::viewer::TwinScene;
+
+/// A twin on a canvas.
+#[wasm_bindgen]
+pub struct Viewer {
+    ctx: Rc<GpuContext>,
+    canvas: web_sys::HtmlCanvasElement,
+    renderer: Rc<RefCell<Rc<GtRenderer>>>,
+    scene: Rc<RefCell<TwinScene>>,
+    /// A frame is being rendered; `again` asks it to render once more when done.
+    busy: Rc<Cell<bool>>,
+    again: Rc<Cell<bool>>,
+}
+
+#[wasm_bindgen]
+impl Viewer {
+    /// A viewer of `result`'s twin on `canvas` (drawn at the canvas's pixel size), at the
+    /// start state.
+    pub async fn create(
+        canvas: web_sys::HtmlCanvasElement,
+        result: FitResult,
+    ) -> Result<Viewer, JsError> {
+        let ctx = context().await?;
+        let (width, height) = (canvas.width().max(1), canvas.height().max(1));
+        let renderer = GtRenderer::new(&ctx, width, height).map_err(js_error)?;
+        let twin = &result.0.twin;
+        let scene = TwinScene::new(twin.object(), twin.end_configuration());
+        Ok(Viewer {
+            ctx,
+            canvas,
+            renderer: Rc::new(RefCell::new(Rc::new(renderer))),
+            scene: Rc::new(RefCell::new(scene)),
+            busy: Rc::default(),
+            again: Rc::default(),
+        })
+    }
+
+    /// The sliders: `[{index, name, type, lower, upper, start, end, unit}]` as JSON.
+    pub fn joints(&self) -> Result<String, JsError> {
+        serde_json::to_string(self.scene.borrow().joints()).map_err(js_error)
+    }
+
+    /// The sliders' current values (degrees / metres).
+    pub fn values(&self) -> Vec<f32> {
+        self.scene.borrow().slider_values()
+    }
+
+    /// Sets slider `i` (clamped to its range); throws for a slider that does not exist.
+    pub fn set_joint(&self, i: u32, value: f32) -> Result<(), JsError> {
+        let mut scene = self.scene.borrow_mut();
+        if scene.set_joint(i as usize, value) {
+            Ok(())
+        } else {
+            Err(JsError::new(&format!(
+                "no joint slider {i} (there are {}), or {value} is not a number",
+                scene.joints().len()
+            )))
+        }
+    }
+
+    /// Every joint at the "start" or "end" state.
+    pub fn set_state(&self, state: String) -> Result<(), JsError> {
+        let end = match state.as_str() {
+            "start" => false,
+            "end" => true,
+            other => {
+                return Err(JsError::new(&format!(
+                    "unknown state '{other}': expected start or end"
+                )));
+            }
+        };
+        self.scene.borrow_mut().set_state(end);
+        Ok(())
+    }
+
+    pub fn orbit(&self, dx: f32, dy: f32) {
+        self.scene.borrow_mut().orbit(dx, dy);
+    }
+
+    pub fn zoom(&self, factor: f32) {
+        self.scene.borrow_mut().zoom(factor);
+    }
+
+    pub fn colour_by_part(&self, on: bool) {
+        self.scene.borrow_mut().colour_by_part = on;
+    }
+
+    pub fn show_axes(&self, on: bool) {
+        self.scene.borrow_mut().show_axes = on;
+    }
+
+    /// Follows the canvas to a new pixel size.
+    pub fn resize(&self, width: u32, height: u32) -> Result<(), JsError> {
+        let (width, height) = (width.max(1), height.max(1));
+        if self.renderer.borrow().size() != (width, height) {
+            let renderer = GtRenderer::new(&self.ctx, width, height).map_err(js_error)?;
+            *self.renderer.borrow_mut() = Rc::new(renderer);
+        }
+        Ok(())
+    }
+
+    /// Draws the scene as it is now; resolves when it is on the canvas. A draw asked for while
+    /// one is running is folded into one more frame after it.
+    pub fn draw(&self) -> js_sys::Promise {
+        if self.busy.get() {
+            self.again.set(true);
+            return js_sys::Promise::resolve(&JsValue::UNDEFINED);
+        }
+        self.busy.set(true);
+        let (ctx, canvas) = (self.ctx.clone(), self.canvas.clone());
+        let (renderer, scene) = (self.renderer.clone(), self.scene.clone());
+        let (busy, again) = (self.busy.clone(), self.again.clone());
+        wasm_bindgen_futures::future_to_promise(async move {
+            let result = async {
+                loop {
+                    again.set(false);
+                    let renderer = renderer.borrow().clone();
+                    let (w, h) = renderer.size();
+                    let (meshes, camera) = {
+                        let scene = scene.borrow();
+                        (scene.meshes(), scene.camera(w, h))
+                    };
+                    let frame = renderer
+                        .render_view(&ctx, &meshes, &camera)
+                        .await
+                        .map_err(|e| JsValue::from_str(&e.to_string()))?;
+                    put_on_canvas(&canvas, &frame.rgba)?;
+                    if !again.get() {
+                        return Ok(JsValue::UNDEFINED);
+                    }
+                }
+            }
+            .await;
+            busy.set(false);
+            result
+        })
+    }
+}
+
+/// Puts `image` on the canvas's 2-D context at its top-left corner (the canvas's CSS background
+/// shows through where nothing was drawn).
+fn put_on_canvas(
+    canvas: &web_sys::HtmlCanvasElement,
+    image: &crate::data::RgbaImage,
+) -> Result<(), JsValue> {
+    let context: web_sys::CanvasRenderingContext2d = canvas
+        .get_context("2d")?
+        .ok_or_else(|| JsValue::from_str("the viewer canvas has no 2-D context"))?
+        .dyn_into()?;
+    let data = web_sys::ImageData::new_with_u8_clamped_array_and_sh(
+        wasm_bindgen::Clamped(&image.pixels),
+        image.width,
+        image.height,
+    )?;
+    context.put_image_data(&data, 0.0, 0.0)
+}

@@ -1,0 +1,207 @@
+// The Fit section: runs `fit` with pause/cancel control, shows its progress (throttled to 10
+// updates a second), the loss curves and the latest render beside its photo.
+// `document.body.dataset.fit` is "running" | "paused" | "done" | "cancelled" | "error";
+// `document.body.dataset.preview` becomes "1" once a preview has been drawn.
+import { $, show, errorText, drawRgba, fmtDuration, showBanner } from "./util.js";
+import { drawLogPlot } from "./plot.js";
+
+const PHASES = {
+  initialise: "setting up",
+  optimise: "optimising the mesh",
+  densify: "adding detail where the error is high",
+  remesh: "rebuilding the triangles",
+  recover: "optimising again after remeshing",
+  candidates: "trying joint candidates",
+  "bake-off": "comparing hinge and slide",
+  refine: "refining the chosen joint",
+  done: "finished",
+};
+const SERIES = [
+  { key: "start", label: "start state", colour: "#1f5fbf" },
+  { key: "end", label: "end state", colour: "#d9730d" },
+  { key: "articulation", label: "articulation", colour: "#1b8a4a" },
+];
+const MAX_POINTS = 4000;
+
+let control = "run";
+let running = false;
+let latest = null;          // last progress event
+let latestPreview = null;   // last preview event
+let dirty = false;
+let timer = null;
+let lastUpdate = 0;
+let points = {};
+
+function setFit(state) {
+  document.body.dataset.fit = state;
+}
+
+function seriesKey(ev) {
+  if (ev.stage === "articulation" || ev.stage === "bake-off decision" || ev.state === "both") return "articulation";
+  return ev.state === "end" ? "end" : "start";
+}
+
+function onEvent(ev) {
+  if (!ev || typeof ev !== "object") return;
+  if (ev.kind === "progress") {
+    latest = ev;
+    const loss = Number(ev.loss);
+    if (ev.loss != null && loss > 0 && Number.isFinite(loss)) {
+      const x = Number.isFinite(ev.fraction) ? ev.fraction * 100 : (ev.elapsed_s ?? 0);
+      const list = points[seriesKey(ev)] ??= [];
+      list.push([x, loss]);
+      if (list.length > MAX_POINTS) points[seriesKey(ev)] = list.filter((_, i) => i % 2 === 0);
+    }
+  } else if (ev.kind === "preview") {
+    latestPreview = ev;
+  }
+  schedule();
+}
+
+function schedule() {
+  dirty = true;
+  if (timer !== null) return;
+  const wait = Math.max(0, 100 - (performance.now() - lastUpdate));
+  timer = setTimeout(() => { timer = null; update(); }, wait);
+}
+
+function text(id, value) {
+  const el = $(id);
+  if (el.textContent !== value) el.textContent = value;
+}
+
+function update() {
+  if (!dirty) return;
+  dirty = false;
+  lastUpdate = performance.now();
+  const ev = latest;
+  if (ev) {
+    text("fit-stage", ev.stage ?? "—");
+    text("fit-phase", ev.phase ? `${ev.phase} (${PHASES[ev.phase] ?? ev.phase})` : "—");
+    text("fit-state", ev.state ?? "—");
+    text("fit-iter", ev.iterations ? `${ev.iteration} / ${ev.iterations}` : String(ev.iteration ?? "—"));
+    text("fit-elapsed", fmtDuration(ev.elapsed_s));
+    let eta = ev.eta_s;
+    if (eta == null && ev.fraction > 0.02 && ev.elapsed_s > 0) eta = (ev.elapsed_s * (1 - ev.fraction)) / ev.fraction;
+    text("fit-eta", eta == null ? "—" : `about ${fmtDuration(eta)}`);
+    text("fit-faces", ev.faces != null ? Number(ev.faces).toLocaleString("en") : "—");
+    text("fit-vertices", ev.vertices != null ? Number(ev.vertices).toLocaleString("en") : "—");
+    const fraction = Math.min(1, Math.max(0, Number(ev.fraction) || 0));
+    $("fit-progress").value = fraction;
+    if (running && control === "run") {
+      const loss = ev.loss != null ? `, loss ${Number(ev.loss).toPrecision(4)}` : "";
+      show($("fit-status"), `Running: ${(fraction * 100).toFixed(0)} % — ${ev.stage ?? ""}, ${PHASES[ev.phase] ?? ev.phase ?? ""}${loss}`);
+    }
+    for (const li of $("stages").children) li.classList.toggle("current", running && li.dataset.stage === ev.stage);
+  }
+  drawLogPlot($("loss-plot"), SERIES.map((s) => ({ ...s, points: points[s.key] ?? [] })),
+    { xLabel: "progress of the whole fit (%)", xMax: 100 });
+  const p = latestPreview;
+  if (p) {
+    latestPreview = null;
+    const a = drawRgba($("preview-render"), p.width, p.height, p.render);
+    const b = drawRgba($("preview-target"), p.width, p.height, p.target);
+    if (a && b) {
+      text("preview-caption", `${p.state} state, iteration ${p.iteration}`);
+      document.body.dataset.preview = "1";
+    }
+  }
+}
+
+function resetPanel() {
+  latest = null; latestPreview = null; points = {};
+  for (const id of ["fit-stage", "fit-phase", "fit-state", "fit-iter", "fit-elapsed", "fit-eta", "fit-faces", "fit-vertices"]) text(id, "—");
+  text("preview-caption", "");
+  $("fit-progress").value = 0;
+  for (const c of [$("preview-render"), $("preview-target")]) { c.width = 1; c.height = 1; }
+  delete document.body.dataset.preview;
+  $("fit-panel").hidden = false;
+  dirty = true;
+  update();
+}
+
+export function wireFitButtons() {
+  $("pause").addEventListener("click", () => {
+    if (!running || control === "cancel") return;
+    if (control === "run") {
+      control = "pause";
+      $("pause").textContent = "Resume";
+      setFit("paused");
+      show($("fit-status"), "Paused. The GPU finishes its current step, then waits; press Resume to go on.");
+    } else {
+      control = "run";
+      $("pause").textContent = "Pause";
+      setFit("running");
+      show($("fit-status"), "Resuming…");
+    }
+  });
+  $("cancel").addEventListener("click", () => {
+    if (!running) return;
+    control = "cancel";
+    $("cancel").disabled = true;
+    $("pause").disabled = true;
+    show($("fit-status"), "Cancelling at the next checkpoint…");
+  });
+  $("pause").disabled = true;
+  $("cancel").disabled = true;
+}
+
+export const fitRunning = () => running;
+
+/** Resolves to the hint shown after a fit error (or ""). */
+function hintFor(message) {
+  return /memory|limit|binding|too many/i.test(message) ? "\nTry a smaller preset (tiny or fast)." : "";
+}
+
+/**
+ * Runs `fitFn(datasetHandle, preset, onEvent, control)`; the handle is consumed.
+ * Resolves to the FitResult, or null when cancelled or failed (the panel says which).
+ */
+export async function runFit(fitFn, datasetHandle, preset, what) {
+  running = true;
+  control = "run";
+  resetPanel();
+  $("pause").textContent = "Pause";
+  $("pause").disabled = false;
+  $("cancel").disabled = false;
+  setFit("running");
+  show($("fit-status"), `Starting the fit of ${what} (preset ${preset})…`);
+  const t0 = performance.now();
+  try {
+    const result = await fitFn(datasetHandle, preset, onEvent, () => control);
+    running = false;
+    dirty = true;
+    update();
+    $("fit-progress").value = 1;
+    const seconds = (performance.now() - t0) / 1000;
+    show($("fit-status"), `Done in ${fmtDuration(seconds)}.`, "ok");
+    for (const li of $("stages").children) li.classList.remove("current");
+    return result;
+  } catch (e) {
+    running = false;
+    dirty = true;
+    update();
+    for (const li of $("stages").children) li.classList.remove("current");
+    const message = errorText(e);
+    if (control === "cancel" || /^cancelled/i.test(message)) {
+      show($("fit-status"), "Cancelled.");
+      setFit("cancelled");
+    } else {
+      show($("fit-status"), `The fit failed: ${message}${hintFor(message)}`, "fail");
+      setFit("error");
+      document.body.dataset.fitError = message;
+      showBanner(`The fit failed: ${message}${hintFor(message)}`);
+    }
+    return null;
+  } finally {
+    running = false;
+    $("pause").disabled = true;
+    $("cancel").disabled = true;
+    $("pause").textContent = "Pause";
+  }
+}
+
+/** Marks the fit done (called by the app once the result is stored). */
+export function markFitDone() {
+  setFit("done");
+}

@@ -1,0 +1,96 @@
+// A small line-plot helper for the loss curves: x linear, y on a log axis, one colour per series.
+// `series` is [{label, colour, points: [[x, y], ...]}]; points with y <= 0 or non-finite are skipped.
+
+/** Sizes the canvas's backing store to its CSS size × devicePixelRatio; returns [width, height, dpr]. */
+export function fitCanvas(canvas) {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(canvas.clientWidth * dpr));
+  const h = Math.max(1, Math.round(canvas.clientHeight * dpr));
+  if (canvas.width !== w) canvas.width = w;
+  if (canvas.height !== h) canvas.height = h;
+  return [w, h, dpr];
+}
+
+function fmtTick(v) {
+  if (v >= 1000 || v < 0.01) return v.toExponential(0).replace("e+", "e");
+  return String(Number(v.toPrecision(2)));
+}
+
+export function drawLogPlot(canvas, series, { xLabel = "", xMax = null } = {}) {
+  const [w, h, dpr] = fitCanvas(canvas);
+  const ctx = canvas.getContext("2d");
+  ctx.setTransform(1, 0, 0, 1, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  ctx.scale(dpr, dpr);
+  const W = w / dpr, H = h / dpr;
+  const pad = { l: 48, r: 10, t: 22, b: 26 };
+  const pw = Math.max(10, W - pad.l - pad.r), ph = Math.max(10, H - pad.t - pad.b);
+  ctx.font = "11px system-ui, sans-serif";
+
+  let x0 = Infinity, x1 = -Infinity, y0 = Infinity, y1 = -Infinity;
+  for (const s of series) for (const [x, y] of s.points) {
+    if (!(y > 0) || !Number.isFinite(y) || !Number.isFinite(x)) continue;
+    x0 = Math.min(x0, x); x1 = Math.max(x1, x);
+    y0 = Math.min(y0, y); y1 = Math.max(y1, y);
+  }
+  ctx.strokeStyle = "#9aa8b5";
+  ctx.lineWidth = 1;
+  ctx.strokeRect(pad.l, pad.t, pw, ph);
+  if (!Number.isFinite(x0)) {
+    ctx.fillStyle = "#6b7680";
+    ctx.fillText("waiting for the first loss…", pad.l + 8, pad.t + 16);
+    return;
+  }
+  if (xMax != null) { x0 = Math.min(x0, 0); x1 = Math.max(x1, xMax); }
+  if (x1 <= x0) x1 = x0 + 1;
+  let ly0 = Math.log10(y0), ly1 = Math.log10(y1);
+  if (ly1 - ly0 < 0.3) { const m = (ly0 + ly1) / 2; ly0 = m - 0.15; ly1 = m + 0.15; }
+  ly0 -= 0.05 * (ly1 - ly0); ly1 += 0.05 * (ly1 - ly0);
+  const X = (x) => pad.l + ((x - x0) / (x1 - x0)) * pw;
+  const Y = (y) => pad.t + (1 - (Math.log10(y) - ly0) / (ly1 - ly0)) * ph;
+
+  // y ticks: powers of ten (and 2×, 5× when the range is short).
+  ctx.fillStyle = "#4a5560";
+  ctx.textAlign = "right";
+  ctx.textBaseline = "middle";
+  const decades = ly1 - ly0;
+  const mults = decades < 1.5 ? [1, 2, 5] : [1];
+  for (let e = Math.floor(ly0); e <= Math.ceil(ly1); e++) {
+    for (const m of mults) {
+      const v = m * 10 ** e, lv = Math.log10(v);
+      if (lv < ly0 || lv > ly1) continue;
+      const y = Y(v);
+      ctx.strokeStyle = "#e4e9ee";
+      ctx.beginPath(); ctx.moveTo(pad.l, y); ctx.lineTo(pad.l + pw, y); ctx.stroke();
+      ctx.fillText(fmtTick(v), pad.l - 4, y);
+    }
+  }
+  ctx.textAlign = "center";
+  ctx.textBaseline = "top";
+  ctx.fillText(xLabel, pad.l + pw / 2, pad.t + ph + 8);
+
+  for (const s of series) {
+    ctx.strokeStyle = s.colour;
+    ctx.lineWidth = 1.5;
+    ctx.beginPath();
+    let pen = false;
+    for (const [x, y] of s.points) {
+      if (!(y > 0) || !Number.isFinite(y)) { pen = false; continue; }
+      if (pen) ctx.lineTo(X(x), Y(y)); else { ctx.moveTo(X(x), Y(y)); pen = true; }
+    }
+    ctx.stroke();
+  }
+
+  // Legend along the top.
+  ctx.textAlign = "left";
+  ctx.textBaseline = "middle";
+  let lx = pad.l;
+  for (const s of series) {
+    if (s.points.length === 0) continue;
+    ctx.fillStyle = s.colour;
+    ctx.fillRect(lx, 7, 14, 4);
+    ctx.fillStyle = "#1d232a";
+    ctx.fillText(s.label, lx + 18, 9);
+    lx += 26 + ctx.measureText(s.label).width;
+  }
+}
