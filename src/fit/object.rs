@@ -53,9 +53,7 @@ impl FitConfig {
         let art = self.articulation.iterations;
         let decide = (art as f32 * self.articulation.decide_at) as u32;
         let total = 2.0 * per_state + f64::from(art);
-        let done = if event.phase.is_articulation()
-            || event.phase == Phase::Done && event.state == State::End && event.iterations > 0
-        {
+        let done = if event.is_articulation() {
             2.0 * per_state
                 + f64::from(match event.phase {
                     Phase::Candidates => event.iteration,

@@ -323,11 +323,6 @@ impl<'a> Trainer<'a> {
         })
     }
 
-    /// The optimiser, for learning-rate schedules.
-    pub fn optimizer(&mut self) -> &mut FieldAdam {
-        &mut self.optimizer
-    }
-
     /// One step on the next view of a shuffled cycle through all views.
     pub async fn step(
         &mut self,
@@ -395,13 +390,13 @@ impl<'a> Trainer<'a> {
     }
 
     /// The current render of training view `view` and its target (composited on the
-    /// background), as RGB8, for a [`Preview`]; the preview's state and iteration are left for
-    /// the caller to fill in.
+    /// background), as RGB8: the [`Preview`] of `state` at `iteration`.
     pub async fn preview(
         &mut self,
         ctx: &GpuContext,
         view: usize,
         settings: &RasterSettings,
+        (state, iteration): (State, u32),
     ) -> GpuResult<Preview> {
         let (Some(camera), Some(frame)) = (self.cameras.get(view), self.frames.get(view)) else {
             return Err(GpuError::InvalidInput(format!(
@@ -414,9 +409,9 @@ impl<'a> Trainer<'a> {
         let render = self.state.read_render(ctx).await?;
         let n = (render.width * render.height) as usize;
         Ok(Preview {
-            state: State::Start,
+            state,
             view,
-            iteration: 0,
+            iteration,
             width: render.width,
             height: render.height,
             render: planes_to_rgb8(&render.planes[..3 * n]),
@@ -432,18 +427,30 @@ impl<'a> Trainer<'a> {
         config: &PhotometricConfig,
         progress: &mut dyn FnMut(&CurvePoint),
     ) -> GpuResult<Vec<CurvePoint>> {
-        let decay = config.position_decay();
         let mut curve = Vec::new();
         for i in 0..config.iterations {
-            let settings = config.settings_at(i);
-            self.optimizer.set_position_lr(decay.lr(i));
-            self.step(ctx, &settings, &config.weights).await?;
-            if let Some(point) = config.report(ctx, self, i, &settings).await? {
+            if let (_, Some(point)) = self.scheduled_step(ctx, config, i).await? {
                 progress(&point);
                 curve.push(point);
             }
         }
         Ok(curve)
+    }
+
+    /// Step `i` of `config`'s schedule: its settings and position rate, one step, and the
+    /// curve point when `i` is a reporting iteration. Returns the settings it stepped with.
+    pub async fn scheduled_step(
+        &mut self,
+        ctx: &GpuContext,
+        config: &PhotometricConfig,
+        i: u32,
+    ) -> GpuResult<(RasterSettings, Option<CurvePoint>)> {
+        let settings = config.settings_at(i);
+        self.optimizer
+            .set_position_lr(config.position_decay().lr(i));
+        self.step(ctx, &settings, &config.weights).await?;
+        let point = config.report(ctx, self, i, &settings).await?;
+        Ok((settings, point))
     }
 
     /// Zeroes the per-face statistics (max blending weight, pixel count) the renders accumulate.

@@ -18,7 +18,7 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::init::{InitOptions, initial_field};
-use super::observer::{Observer, Preview, checkpoint};
+use super::observer::{Observer, checkpoint};
 use super::photometric::{CurvePoint, PhotometricConfig, Trainer};
 use super::views::downsample_frame;
 use crate::data::{Camera, Dataset, Frame, GroundTruth, GtMeshes, Split, State, TriMesh};
@@ -328,6 +328,15 @@ pub struct Progress {
     pub faces: usize,
     /// Seconds since this state's reconstruction began.
     pub elapsed_s: f64,
+}
+
+impl Progress {
+    /// Whether the event comes from the articulation phase: one of its stages, or its closing
+    /// [`Phase::Done`], the only `Done` that counts steps (a state's reconstruction ends with 0
+    /// of 0).
+    pub fn is_articulation(&self) -> bool {
+        self.phase.is_articulation() || (self.phase == Phase::Done && self.iterations > 0)
+    }
 }
 
 /// Wall-clock seconds spent in each phase of one state.
@@ -659,12 +668,8 @@ async fn watch(
 ) -> GpuResult<()> {
     checkpoint(observer, event).await?;
     if observer.wants_preview() {
-        let preview = trainer.preview(ctx, 0, settings).await?;
-        observer.preview(Preview {
-            state: event.state,
-            iteration: event.iteration,
-            ..preview
-        });
+        let at = (event.state, event.iteration);
+        observer.preview(trainer.preview(ctx, 0, settings, at).await?);
     }
     Ok(())
 }
@@ -729,13 +734,12 @@ pub async fn reconstruct_state(
 
     // Optimisation with densification and pruning.
     let fit = &config.fit;
-    let decay = fit.position_decay();
     let mut trainer = Trainer::new(
         ctx,
         &cameras,
         frames,
         &field,
-        fit.rates(decay.lr(0)),
+        fit.rates(fit.position_decay().lr(0)),
         fit.seed,
     )?;
     let mut sizes = (field.num_vertices(), field.faces.len());
@@ -748,10 +752,7 @@ pub async fn reconstruct_state(
     let mut curve = Vec::new();
     trainer.clear_face_stats(ctx);
     for i in 0..fit.iterations {
-        let settings = fit.settings_at(i);
-        trainer.optimizer().set_position_lr(decay.lr(i));
-        trainer.step(ctx, &settings, &fit.weights).await?;
-        if let Some(point) = fit.report(ctx, &mut trainer, i, &settings).await? {
+        if let (settings, Some(point)) = trainer.scheduled_step(ctx, fit, i).await? {
             times.optimise_s += lap();
             let at = event(
                 Phase::Optimise,
@@ -817,12 +818,8 @@ pub async fn reconstruct_state(
     )?;
     let psnr_remeshed = trainer.mean_psnr(ctx, &recovery.settings_at(0)).await?;
     times.measure_s += lap();
-    let decay = recovery.position_decay();
     for i in 0..recovery.iterations {
-        let settings = recovery.settings_at(i);
-        trainer.optimizer().set_position_lr(decay.lr(i));
-        trainer.step(ctx, &settings, &recovery.weights).await?;
-        if let Some(point) = recovery.report(ctx, &mut trainer, i, &settings).await? {
+        if let (settings, Some(point)) = trainer.scheduled_step(ctx, &recovery, i).await? {
             let at = event(
                 Phase::Recover,
                 i + 1,

@@ -75,8 +75,6 @@ pub struct AdapterReport {
 
 /// A device and queue with the adapter's own limits, plus captured errors.
 pub struct GpuContext {
-    /// The instance the adapter came from (the page's viewer makes its canvas surface with it).
-    pub instance: wgpu::Instance,
     pub device: wgpu::Device,
     pub queue: wgpu::Queue,
     pub adapter: AdapterReport,
@@ -159,7 +157,6 @@ impl GpuContext {
             max_storage_buffers_per_shader_stage: limits.max_storage_buffers_per_shader_stage,
         };
         Ok(Self {
-            instance,
             device,
             queue,
             dispatch_dim_limit: limits.max_compute_workgroups_per_dimension.max(1),

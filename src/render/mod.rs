@@ -318,50 +318,6 @@ impl GtRenderer {
         meshes: &[PartMesh],
         camera: &Camera,
     ) -> GpuResult<RenderedView> {
-        let color = self.color.create_view(&Default::default());
-        let mut encoder = self.encode(ctx, meshes, camera, &color, wgpu::Color::TRANSPARENT)?;
-        let region = self.padded_row as u64 * self.height as u64;
-        for (k, texture) in [&self.color, &self.depth, &self.part]
-            .into_iter()
-            .enumerate()
-        {
-            encoder.copy_texture_to_buffer(
-                wgpu::TexelCopyTextureInfo {
-                    texture,
-                    mip_level: 0,
-                    origin: wgpu::Origin3d::ZERO,
-                    aspect: wgpu::TextureAspect::All,
-                },
-                wgpu::TexelCopyBufferInfo {
-                    buffer: &self.readback,
-                    layout: wgpu::TexelCopyBufferLayout {
-                        offset: k as u64 * region,
-                        bytes_per_row: Some(self.padded_row),
-                        rows_per_image: Some(self.height),
-                    },
-                },
-                wgpu::Extent3d {
-                    width: self.width,
-                    height: self.height,
-                    depth_or_array_layers: 1,
-                },
-            );
-        }
-        ctx.queue.submit([encoder.finish()]);
-        let bytes: Vec<u8> = ctx.read_buffer(&self.readback, 3 * region as usize).await?;
-        Ok(self.unpack(&bytes))
-    }
-
-    /// Uploads `meshes` and records their render pass into `color` (the depth and part ids go
-    /// to the renderer's own targets).
-    fn encode(
-        &self,
-        ctx: &GpuContext,
-        meshes: &[PartMesh],
-        camera: &Camera,
-        color: &wgpu::TextureView,
-        background: wgpu::Color,
-    ) -> GpuResult<wgpu::CommandEncoder> {
         let k = camera.intrinsics;
         if (k.width, k.height) != (self.width, self.height) {
             return Err(invalid(format!(
@@ -467,7 +423,8 @@ impl GtRenderer {
             draws.push((vertex_buffer, index_buffer, index_count as u32, group));
         }
 
-        let views = [&self.depth, &self.part].map(|t| t.create_view(&Default::default()));
+        let views =
+            [&self.color, &self.depth, &self.part].map(|t| t.create_view(&Default::default()));
         let zview = self.zbuffer.create_view(&Default::default());
         let mut encoder = device.create_command_encoder(&Default::default());
         {
@@ -485,11 +442,11 @@ impl GtRenderer {
             let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("render_gt"),
                 color_attachments: &[
-                    clear(color, background),
                     clear(&views[0], wgpu::Color::TRANSPARENT),
+                    clear(&views[1], wgpu::Color::TRANSPARENT),
                     // Integer targets take the clear value's red channel as the integer: background −1.
                     clear(
-                        &views[1],
+                        &views[2],
                         wgpu::Color {
                             r: -1.0,
                             g: 0.0,
@@ -520,7 +477,36 @@ impl GtRenderer {
                 pass.draw_indexed(0..*count, 0, 0..1);
             }
         }
-        Ok(encoder)
+        let region = self.padded_row as u64 * self.height as u64;
+        for (k, texture) in [&self.color, &self.depth, &self.part]
+            .into_iter()
+            .enumerate()
+        {
+            encoder.copy_texture_to_buffer(
+                wgpu::TexelCopyTextureInfo {
+                    texture,
+                    mip_level: 0,
+                    origin: wgpu::Origin3d::ZERO,
+                    aspect: wgpu::TextureAspect::All,
+                },
+                wgpu::TexelCopyBufferInfo {
+                    buffer: &self.readback,
+                    layout: wgpu::TexelCopyBufferLayout {
+                        offset: k as u64 * region,
+                        bytes_per_row: Some(self.padded_row),
+                        rows_per_image: Some(self.height),
+                    },
+                },
+                wgpu::Extent3d {
+                    width: self.width,
+                    height: self.height,
+                    depth_or_array_layers: 1,
+                },
+            );
+        }
+        ctx.queue.submit([encoder.finish()]);
+        let bytes: Vec<u8> = ctx.read_buffer(&self.readback, 3 * region as usize).await?;
+        Ok(self.unpack(&bytes))
     }
 
     /// Strips the row padding of the three read-back targets and converts them to the output images.
@@ -595,7 +581,8 @@ fn vertices_of(i: usize, m: &RenderMesh) -> GpuResult<Vec<Vertex>> {
     let uvs = m.uvs.as_deref().unwrap_or(&[]);
     let colors = m.colors.as_deref().unwrap_or(&[]);
     let finite = |c: [f32; 3]| c.map(|v| if v.is_finite() { v } else { 0.0 });
-    let material = finite([0, 1, 2].map(|k| m.material.base_color[k]));
+    let [r, g, b, _] = m.material.base_color;
+    let material = finite([r, g, b]);
     Ok(m.positions
         .iter()
         .enumerate()

@@ -7,7 +7,7 @@ use std::rc::Rc;
 use js_sys::{Array, Function, Object, Reflect, Uint8ClampedArray};
 use wasm_bindgen::prelude::*;
 
-use super::{context, file_set, js_error};
+use super::{context, js_error};
 use crate::data::{Dataset, FileSet, Split, State, read_zip, rebase_on_dataset_root};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::{FitConfig, fit_object};
@@ -20,7 +20,7 @@ use crate::synth::{Category, SynthParams, generate};
 const PREVIEW_EVERY_S: f64 = 1.5;
 
 /// A plain JS object from key/value pairs.
-fn object(pairs: &[(&str, JsValue)]) -> JsValue {
+fn js_object(pairs: &[(&str, JsValue)]) -> JsValue {
     let o = Object::new();
     for (k, v) in pairs {
         let _ = Reflect::set(&o, &JsValue::from_str(k), v);
@@ -43,6 +43,21 @@ fn rgba_array(pixels: &[u8], channels: usize) -> Uint8ClampedArray {
             .collect()
     };
     Uint8ClampedArray::from(rgba.as_slice())
+}
+
+/// Pairs dropped files' paths (relative, '/'-separated) with their contents.
+fn file_set(paths: Vec<String>, contents: Vec<js_sys::Uint8Array>) -> Result<FileSet, JsError> {
+    if paths.len() != contents.len() {
+        return Err(JsError::new(&format!(
+            "{} paths for {} file contents",
+            paths.len(),
+            contents.len()
+        )));
+    }
+    Ok(paths
+        .into_iter()
+        .zip(contents.iter().map(|c| c.to_vec()))
+        .collect())
 }
 
 /// The demo's choices as JSON: categories with their part counts, presets, defaults.
@@ -160,7 +175,10 @@ impl WebDataset {
             &object,
             &config.demo_capture(seed.into()),
             &mut |p| {
-                let ev = object_of_progress(p.done, p.total);
+                let ev = js_object(&[
+                    ("done", number(p.done as u32)),
+                    ("total", number(p.total as u32)),
+                ]);
                 let _ = on_progress.call1(&JsValue::NULL, &ev);
             },
         )
@@ -182,10 +200,6 @@ impl WebDataset {
         self.0.dataset.summary().to_string()
     }
 
-    pub fn summary_json(&self) -> Result<String, JsError> {
-        serde_json::to_string(&self.0.dataset.summary()).map_err(js_error)
-    }
-
     /// The first `per_state` training images of each state:
     /// `[{state, view, width, height, rgba}]`.
     pub fn thumbnails(&self, per_state: u32) -> Array {
@@ -196,7 +210,7 @@ impl WebDataset {
             };
             for (i, frame) in views.frames.iter().take(per_state as usize).enumerate() {
                 let img = &frame.rgba;
-                out.push(&object(&[
+                out.push(&js_object(&[
                     ("state", JsValue::from_str(state.name())),
                     ("view", number(i as u32)),
                     ("width", number(img.width)),
@@ -212,13 +226,6 @@ impl WebDataset {
     pub fn share(&self) -> WebDataset {
         WebDataset(self.0.clone())
     }
-}
-
-fn object_of_progress(done: usize, total: usize) -> JsValue {
-    object(&[
-        ("done", number(done as u32)),
-        ("total", number(total as u32)),
-    ])
 }
 
 /// The page as a fit's observer: events and previews go to `on_event`, `control()` is asked
@@ -242,13 +249,13 @@ impl Observer for PageObserver {
         let elapsed = now_seconds() - self.t0;
         let fraction = self.config.fraction_done(e);
         let eta = (fraction > 0.02).then(|| elapsed * (1.0 - fraction) / fraction);
-        let state = if e.phase.is_articulation() {
+        let state = if e.is_articulation() {
             "both"
         } else {
             e.state.name()
         };
         let opt = |v: Option<f64>| v.map_or(JsValue::NULL, JsValue::from_f64);
-        self.send(&object(&[
+        self.send(&js_object(&[
             ("kind", "progress".into()),
             ("state", state.into()),
             ("phase", e.phase.name().into()),
@@ -275,7 +282,7 @@ impl Observer for PageObserver {
     }
 
     fn preview(&mut self, p: Preview) {
-        self.send(&object(&[
+        self.send(&js_object(&[
             ("kind", "preview".into()),
             ("state", p.state.name().into()),
             ("view", number(p.view as u32)),

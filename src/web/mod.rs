@@ -16,7 +16,6 @@ use std::rc::Rc;
 
 use wasm_bindgen::prelude::*;
 
-use crate::data::{Dataset, FileSet};
 use crate::gpu::{GpuContext, selftest};
 
 thread_local! {
@@ -97,41 +96,5 @@ pub async fn gpu_self_test(max_size: u32) -> Result<String, JsError> {
         .collect();
     let report = selftest::run(&ctx, &sizes).await.map_err(js_error)?;
     let value = serde_json::json!({ "passed": report.passed(), "report": report });
-    serde_json::to_string(&value).map_err(js_error)
-}
-
-/// Pairs dropped files' paths (relative, '/'-separated) with their contents.
-fn file_set(paths: Vec<String>, contents: Vec<js_sys::Uint8Array>) -> Result<FileSet, JsError> {
-    if paths.len() != contents.len() {
-        return Err(JsError::new(&format!(
-            "{} paths for {} file contents",
-            paths.len(),
-            contents.len()
-        )));
-    }
-    Ok(paths
-        .into_iter()
-        .zip(contents.iter().map(|c| c.to_vec()))
-        .collect())
-}
-
-/// Checks a dropped dataset: `paths[i]` (relative, '/'-separated) holds `contents[i]`.
-/// Returns `{"ok": true, "summary": ...}` or `{"ok": false, "problems": [...]}` as JSON.
-#[wasm_bindgen]
-pub fn inspect_dataset(
-    paths: Vec<String>,
-    contents: Vec<js_sys::Uint8Array>,
-) -> Result<String, JsError> {
-    let files = file_set(paths, contents)?;
-    let value = match Dataset::from_files(&files) {
-        Ok(dataset) => {
-            let summary = dataset.summary();
-            serde_json::json!({ "ok": true, "text": summary.to_string(), "summary": summary })
-        }
-        Err(problems) => serde_json::json!({
-            "ok": false,
-            "problems": problems.0.iter().map(ToString::to_string).collect::<Vec<_>>(),
-        }),
-    };
     serde_json::to_string(&value).map_err(js_error)
 }

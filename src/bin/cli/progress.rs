@@ -62,7 +62,7 @@ impl Bar {
             "{}: {:<6} {:<10} [{bar}]{steps}{loss}{psnr}  {} faces  {:.0} s{eta}",
             self.label,
             // The articulation phase works on both states at once.
-            if p.phase.is_articulation() {
+            if p.is_articulation() {
                 "joints"
             } else {
                 p.state.name()
