@@ -2,7 +2,7 @@
 // request, takes a demo object or a dataset, runs the fit and shows the twin. All computation
 // happens in the wasm module (web/pkg); these files only move data in and show results.
 // `document.body.dataset.state` tells tests where the page is: loading → done | error | panic.
-import { $, show, errorText, showBanner, hideBanner } from "./util.js";
+import { $, show, errorText, showBanner, hideBanner, freeQuietly } from "./util.js";
 import { setupInput, showDataset } from "./input.js";
 import { wireFitButtons, runFit, markFitDone } from "./fit-ui.js";
 import { wireResultButtons, showResult, clearResult } from "./result-ui.js";
@@ -24,10 +24,6 @@ function updateButtons() {
   $("fit-run").disabled = !gpu || busy || !currentDataset;
 }
 
-function freeQuietly(handle) {
-  try { handle?.free?.(); } catch { /* already freed */ }
-}
-
 // --- errors that end the session ----------------------------------------------------------
 
 function wireFatalEvents() {
@@ -41,9 +37,8 @@ function wireFatalEvents() {
     updateButtons();
   });
   window.addEventListener("artmesh-device-lost", (e) => {
+    // Only the page's current device is announced (src/web/mod.rs), so every event is a real loss.
     const reason = String(e.detail ?? "unknown reason");
-    // A device destroyed on purpose (its context dropped) is not a loss.
-    if (/^\s*destroyed\b/i.test(reason)) return;
     broken = true;
     document.body.dataset.deviceLost = "1";
     showBanner(`The GPU device was lost (${reason}). This happens when the graphics driver resets or the GPU ` +

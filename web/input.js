@@ -1,7 +1,7 @@
 // The Input section's dataset half: reads a dropped or picked folder or .zip into a wasm Dataset,
 // shows its summary and thumbnails, or the readers' problems. `document.body.dataset.dataset`
 // becomes "ok" or "problems" (tests wait on it).
-import { $, errorText, drawRgba } from "./util.js";
+import { $, errorText, drawRgba, freeQuietly } from "./util.js";
 
 let Dataset = null;
 let hooks = { onDataset: () => {}, onProblems: () => {} };
@@ -108,7 +108,7 @@ async function loadFiles(pairs) {
     if (token === loadToken) problems(errorText(e));
     return;
   }
-  if (token !== loadToken) { try { ds.free(); } catch { /* already gone */ } return; }
+  if (token !== loadToken) { freeQuietly(ds); return; }
   hooks.onDataset(ds);
 }
 
@@ -125,7 +125,7 @@ async function loadZip(file) {
     if (token === loadToken) problems(errorText(e));
     return;
   }
-  if (token !== loadToken) { try { ds.free(); } catch { /* already gone */ } return; }
+  if (token !== loadToken) { freeQuietly(ds); return; }
   hooks.onDataset(ds);
 }
 

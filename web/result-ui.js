@@ -1,17 +1,13 @@
 // The Result section: the WebGPU viewer of the twin (orbit, zoom, a slider per joint), the
 // metrics and joints tables, the report's warnings and the downloads.
 // Sets `document.body.dataset.result = "ready"` and `document.body.dataset.jointCount`.
-import { $, errorText, fmtNum } from "./util.js";
+import { $, errorText, fmtNum, freeQuietly } from "./util.js";
 
 let viewer = null;
 let result = null;
 let canvas = null;
 let resizeObserver = null;
 let drawPending = false;
-
-function freeQuietly(handle) {
-  try { handle?.free?.(); } catch { /* already freed */ }
-}
 
 /** Forgets the shown result (before a new fit starts). */
 export function clearResult() {

@@ -62,3 +62,8 @@ export function showBanner(message, action) {
 export function hideBanner() {
   $("error").hidden = true;
 }
+
+/** Frees a wasm handle (Dataset, FitResult, Viewer) unless it is already gone. */
+export function freeQuietly(handle) {
+  try { handle?.free?.(); } catch { /* already freed */ }
+}
