@@ -8,7 +8,7 @@ mod common;
 use artmesh::data::{Dataset, State};
 use artmesh::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use artmesh::fit::object::{FitConfig, fit_object};
-use artmesh::fit::observer::{Command, Observer, Preview};
+use artmesh::fit::observer::{Command, Observer, Preview, Unobserved};
 use artmesh::fit::reconstruct::{Phase, Preset, Progress};
 use artmesh::gpu::{GpuContext, GpuError};
 use artmesh::render::viewer::TwinScene;
@@ -41,6 +41,8 @@ struct Recorder {
     pauses: usize,
     paused: usize,
     cancel_at: Option<usize>,
+    /// Previews wanted (default 3).
+    previews_wanted: Option<usize>,
 }
 
 impl Observer for Recorder {
@@ -48,7 +50,7 @@ impl Observer for Recorder {
         self.events.push(*event);
     }
     fn wants_preview(&mut self) -> bool {
-        self.previews.len() < 3
+        self.previews.len() < self.previews_wanted.unwrap_or(3)
     }
     fn preview(&mut self, preview: Preview) {
         self.previews.push(preview);
@@ -98,7 +100,11 @@ fn a_heard_fit_reports_every_stage_in_order_and_its_folder_holds_the_downloads()
     let ctx = common::context();
     let config = FitConfig::preset(Preset::Tiny);
     let dataset = laptop(&ctx, &config);
-    let mut recorder = Recorder::default();
+    // A preview at every checkpoint, the page's worst case.
+    let mut recorder = Recorder {
+        previews_wanted: Some(usize::MAX),
+        ..Recorder::default()
+    };
     let fit = pollster::block_on(fit_object(&ctx, &dataset, &config, &mut recorder)).unwrap();
     let fractions: Vec<f64> = recorder
         .events
@@ -122,7 +128,30 @@ fn a_heard_fit_reports_every_stage_in_order_and_its_folder_holds_the_downloads()
     }
     let last = recorder.events.last().unwrap();
     assert_eq!((last.phase, last.state), (Phase::Done, State::End));
-    assert_eq!(recorder.previews.len(), 3);
+    assert!(
+        recorder.previews.len() > 10,
+        "{} previews",
+        recorder.previews.len()
+    );
+    // Watching a fit changes nothing: unwatched, the same fit gives the same meshes and joints.
+    let unwatched =
+        pollster::block_on(fit_object(&ctx, &dataset, &config, &mut Unobserved)).unwrap();
+    for (a, b) in fit
+        .reconstruction
+        .states
+        .iter()
+        .zip(&unwatched.reconstruction.states)
+    {
+        assert!(
+            a.field == b.field,
+            "the previews changed the {:?} state's mesh",
+            a.state
+        );
+    }
+    assert_eq!(
+        fit.articulation.gt_joints(),
+        unwatched.articulation.gt_joints()
+    );
 
     let folder = FitFolder::build(&fit, &dataset, &config, "laptop", "Laptop", 1.0).unwrap();
     for file in [

@@ -191,7 +191,7 @@ async fn loss_gradients_and_adam_match_cpu_in_the_browser() {
 /// The photometric driver's short fit (the same as `tests/fit_photometric.rs`) on the browser's
 /// adapter: capture, rasterizer, loss and Adam together must raise the training PSNR.
 #[wasm_bindgen_test]
-async fn a_short_photometric_fit_learns_in_the_browser() {
+async fn a_short_photometric_fit_learns_and_repeats_in_the_browser() {
     use artmesh::fit::photometric;
     let ctx = context().await;
     let (spec, config) = photometric::short_fit();
@@ -212,6 +212,19 @@ async fn a_short_photometric_fit_learns_in_the_browser() {
         result.psnr_start,
         result.psnr_end
     );
+    // The same fit again lands on the same vertices, bit for bit: SwiftShader's compare-exchange
+    // sums in the backward pass come in a fixed order, so browser fits are reproducible.
+    let again = photometric::fit(&ctx, &problem, &config, &mut |_| {})
+        .await
+        .unwrap();
+    let moved = result
+        .field
+        .positions
+        .iter()
+        .zip(&again.field.positions)
+        .filter(|(p, q)| p != q)
+        .count();
+    assert_eq!(moved, 0, "a repeated fit moved {moved} vertices elsewhere");
 }
 
 #[wasm_bindgen_test]

@@ -274,6 +274,10 @@ pub struct Trainer<'a> {
     /// The field being optimised.
     pub field: GpuField,
     state: RasterState,
+    /// Previews render into their own state: the training state's face statistics (which
+    /// densification reads) would otherwise count the preview's view too, and a fit would
+    /// depend on when, and whether, someone watched it.
+    preview_state: Option<RasterState>,
     loss: ImageLoss,
     targets: TargetImages,
     optimizer: FieldAdam,
@@ -312,6 +316,7 @@ impl<'a> Trainer<'a> {
         Ok(Self {
             raster: Rasterizer::new(ctx),
             state: RasterState::new(ctx, w, h, parts)?,
+            preview_state: None,
             loss: ImageLoss::new(ctx, w, h, parts)?,
             targets: TargetImages::upload(ctx, w, h, &views)?,
             optimizer: FieldAdam::new(ctx, &gpu_field, lr)?,
@@ -403,10 +408,19 @@ impl<'a> Trainer<'a> {
                 "no training view {view} to preview"
             )));
         };
+        let raster_state = match &mut self.preview_state {
+            Some(raster_state) => raster_state,
+            None => self.preview_state.insert(RasterState::new(
+                ctx,
+                frame.rgba.width,
+                frame.rgba.height,
+                self.field.num_parts,
+            )?),
+        };
         self.raster
-            .forward(ctx, &self.field, &mut self.state, camera, settings)
+            .forward(ctx, &self.field, raster_state, camera, settings)
             .await?;
-        let render = self.state.read_render(ctx).await?;
+        let render = raster_state.read_render(ctx).await?;
         let n = (render.width * render.height) as usize;
         Ok(Preview {
             state,

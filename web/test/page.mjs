@@ -147,14 +147,29 @@ try {
     const last = await page.evaluate(() => window.artmeshLast ?? null);
     const pj = parse(last.joints).slice().sort((a, b) => a.part - b.part);
     const nj = JSON.parse(await readFile(join(out, "fit", "joints.json"), "utf8")).sort((a, b) => a.part - b.part);
+    // Both reports kept, and where the two fits part ways printed: the first stage whose
+    // numbers differ (densify counts and PSNRs compared to 4 digits, remeshed face counts exact).
+    const nativeReport = await readFile(join(out, "fit", "report.json"), "utf8");
+    await writeFile(artefacts + "parity-page-report.json", last.report);
+    await writeFile(artefacts + "parity-native-report.json", nativeReport);
+    const [ps, ns] = [parse(last.report), JSON.parse(nativeReport)].map((r) => r.reconstruction.states);
+    const parting = ps.flatMap((p, i) => [
+      ["faces split", p.faces_split, ns[i].faces_split],
+      ["faces pruned", p.faces_pruned, ns[i].faces_pruned],
+      ["PSNR optimised", p.psnr_optimised.toFixed(4), ns[i].psnr_optimised.toFixed(4)],
+      ["remeshed faces", p.remesh.faces_built, ns[i].remesh.faces_built],
+    ].map(([what, a, b]) => ({ what: `${p.state} state ${what}`, a, b }))).find((d) => d.a !== d.b);
+    console.log(parting ? `note the fits part ways at the ${parting.what}: page ${parting.a}, native ${parting.b}`
+      : "note the reconstructions agree in every reported count");
     const types = (js) => js.map((j) => j.type).join(",");
     if (!check(pj.length === nj.length && types(pj) === types(nj),
       `page joints match native in number and type (page ${types(pj)}; native ${types(nj)})`)) return;
-    // The issue asks for 0.5° / 5 mm. Measured at the tiny preset (32 px, 4 views): the native
-    // fit repeats to the digit, the browser's does not (SwiftShader's float atomics order), and
-    // the two differ by ~3° in axis and up to ~6° in motion — within the tiny fit's own accuracy
-    // against the ground truth (< 10°, tests/articulation.rs). This asserts that bound and prints
-    // the measured gap against the target, which is not met yet.
+    // The issue asks for 0.5° / 5 mm. Both fits repeat to the digit, but SwiftShader and lavapipe
+    // round differently (PSNRs agree to ~1e-4 dB after optimisation); remeshing turns that into a
+    // few faces' difference, and the articulation at 32 px / 4 views turns those into ~3° of axis
+    // (natively, a 1e-6 change of the reconstruction's SSIM weight moves it 5°). So this asserts the tiny
+    // fit's accuracy bound against the ground truth (< 10°, tests/articulation.rs) and prints the
+    // gap against the target, which is not met.
     const [angleTol, mmTol, motionTol] = [10, 0.02, [10, 0.02]];
     for (let i = 0; i < nj.length; i++) {
       const a = nj[i], b = pj[i];
