@@ -726,3 +726,114 @@ pub fn fit(
         total_s: started.elapsed().as_secs_f64(),
     })
 }
+
+/// One fit of `artmesh bench spread`.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpreadRun {
+    /// The factor on the reconstruction's SSIM weight (1 for the unchanged fit).
+    pub ssim_factor: f64,
+    pub seconds: f64,
+    /// Per state: mean training PSNR after the optimisation and the faces remeshing built, the
+    /// first numbers where two fits part ways.
+    pub psnr_optimised: Vec<f64>,
+    pub remeshed_faces: Vec<usize>,
+    pub joints: Vec<crate::fit::object::JointRecord>,
+}
+
+/// How far one part's joint moved in a changed fit from the unchanged one.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct JointShift {
+    pub part: usize,
+    pub same_type: bool,
+    pub axis_deg: f64,
+    /// Distance between the axis lines (revolute joints), metres.
+    pub axis_line_m: Option<f64>,
+    /// Part Motion between the two (° or m, in the unchanged joint's type).
+    pub motion: f64,
+}
+
+/// `artmesh bench spread` output: the same dataset fitted `runs` times, each time with the
+/// reconstruction's SSIM weight scaled by 1 + k·`step` — a change at the level of rounding —
+/// and each changed fit's joints against the unchanged one's. Two backends that round
+/// differently (lavapipe and SwiftShader, or two GPUs) can be expected to disagree by as much.
+#[derive(Debug, Clone, Serialize)]
+pub struct SpreadBench {
+    pub bench: &'static str,
+    pub adapter: AdapterReport,
+    pub preset: crate::fit::reconstruct::Preset,
+    pub step: f64,
+    pub fits: Vec<SpreadRun>,
+    /// `shifts[k - 1]`: fit k's joints against fit 0's.
+    pub shifts: Vec<Vec<JointShift>>,
+    /// The largest shift over the changed fits: axis (°), axis line (m), motion.
+    pub max_axis_deg: f64,
+    pub max_axis_line_m: f64,
+    pub max_motion: f64,
+    pub total_s: f64,
+}
+
+/// Fits `dataset` with `config` `runs` times (see [`SpreadBench`]).
+pub fn spread(
+    ctx: &GpuContext,
+    dataset: &crate::data::Dataset,
+    config: &crate::fit::object::FitConfig,
+    runs: usize,
+    step: f64,
+    log: &mut dyn FnMut(&SpreadRun),
+) -> Result<SpreadBench, String> {
+    use crate::eval::joints::{axis_angle_deg, axis_line_distance, motion_error};
+    use crate::fit::object::fit_object;
+    let started = Instant::now();
+    let mut fits = Vec::new();
+    let mut gt_joints = Vec::new();
+    for k in 0..runs.max(2) {
+        let ssim_factor = 1.0 + k as f64 * step;
+        let mut changed = *config;
+        changed.reconstruction.fit.weights.ssim *= ssim_factor as f32;
+        let start = Instant::now();
+        let fit = pollster::block_on(fit_object(ctx, dataset, &changed, &mut Unobserved))
+            .map_err(|e| format!("fit {k}: {e}"))?;
+        let states = &fit.reconstruction.states;
+        let run = SpreadRun {
+            ssim_factor,
+            seconds: start.elapsed().as_secs_f64(),
+            psnr_optimised: states.iter().map(|s| s.psnr_optimised).collect(),
+            remeshed_faces: states.iter().map(|s| s.remesh.faces_built).collect(),
+            joints: fit.joint_records(),
+        };
+        log(&run);
+        fits.push(run);
+        gt_joints.push(fit.articulation.gt_joints());
+    }
+    let shifts: Vec<Vec<JointShift>> = gt_joints[1..]
+        .iter()
+        .map(|joints| {
+            gt_joints[0]
+                .iter()
+                .zip(joints)
+                .enumerate()
+                .map(|(i, (a, b))| JointShift {
+                    part: i + 1,
+                    same_type: a.kind == b.kind,
+                    axis_deg: axis_angle_deg(a.direction, b.direction),
+                    axis_line_m: (a.kind == crate::data::JointKind::Revolute)
+                        .then(|| axis_line_distance(a.origin, a.direction, b.origin, b.direction)),
+                    motion: motion_error(b, a),
+                })
+                .collect()
+        })
+        .collect();
+    let max = |f: &dyn Fn(&JointShift) -> f64| shifts.iter().flatten().map(f).fold(0.0, f64::max);
+    Ok(SpreadBench {
+        bench: "spread",
+        adapter: ctx.adapter.clone(),
+        preset: config.reconstruction.preset,
+        step,
+        max_axis_deg: max(&|s| s.axis_deg),
+        max_axis_line_m: max(&|s| s.axis_line_m.unwrap_or(0.0)),
+        max_motion: max(&|s| s.motion),
+        fits,
+        shifts,
+        total_s: started.elapsed().as_secs_f64(),
+    })
+}

@@ -514,4 +514,21 @@ fn demo_writes_the_twin_and_export_rewrites_it() {
         text(&wrong.stderr)
     );
     assert!(!Path::new(&tmp.join("x.glb")).exists());
+
+    // The spread benchmark on the demo's dataset: two fits, the second one's shift per joint.
+    let dataset = format!("{demo}/dataset");
+    let spread = json(&artmesh(&["bench", "spread", &dataset, "--runs", "2"]));
+    assert_eq!(spread["fits"].as_array().unwrap().len(), 2);
+    assert_eq!(spread["fits"][1]["ssim_factor"].as_f64(), Some(1.000001));
+    let shifts = spread["shifts"][0].as_array().unwrap();
+    assert_eq!(shifts.len(), joints.as_array().unwrap().len());
+    let worst = spread["max_axis_deg"].as_f64().unwrap();
+    assert!((0.0..=90.0).contains(&worst), "{spread}");
+    let missing = artmesh(&["bench", "spread", &tmp.join("nowhere")]);
+    assert_eq!(missing.status.code(), Some(1));
+    assert!(
+        text(&missing.stderr).contains("nowhere"),
+        "{}",
+        text(&missing.stderr)
+    );
 }

@@ -394,6 +394,22 @@ mod cli {
             #[arg(long)]
             markdown: Option<PathBuf>,
         },
+        /// How far rounding-level changes move a fit's joints: the dataset fitted RUNS times, fit k
+        /// with the reconstruction's SSIM weight scaled by 1 + k x STEP, each fit's joints against
+        /// the unchanged fit's (axis angle, axis-line distance, motion). The yardstick for comparing
+        /// fits on backends that round differently (native vs browser). Progress on stderr.
+        Spread {
+            /// Dataset folder.
+            dataset: PathBuf,
+            #[arg(long, default_value = "tiny", value_parser = ["tiny", "fast", "paper"])]
+            preset: String,
+            /// Fits, the unchanged one included.
+            #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=100))]
+            runs: u32,
+            /// Relative change of the SSIM weight per fit.
+            #[arg(long, default_value_t = 1e-6)]
+            step: f64,
+        },
         /// Radix-sort throughput (keys/s) on the current adapter.
         Sort {
             /// Key counts to time.
@@ -817,6 +833,40 @@ mod cli {
                 if let Some(path) = &markdown {
                     std::fs::write(path, md).map_err(|e| format!("{}: {e}", path.display()))?;
                 }
+                out!("{}", to_json(&report)?);
+                Ok(ExitCode::SUCCESS)
+            }
+            Command::Bench {
+                which:
+                    Bench::Spread {
+                        dataset: root,
+                        preset,
+                        runs,
+                        step,
+                    },
+            } => {
+                let config = fit_config(&preset)?;
+                let files = data::read_dir(&root).map_err(|e| e.to_string())?;
+                let dataset = Dataset::from_files(&files)
+                    .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))?;
+                let ctx = context()?;
+                let report = artmesh::bench::spread(
+                    &ctx,
+                    &dataset,
+                    &config,
+                    runs as usize,
+                    step,
+                    &mut |r| {
+                        eprintln!(
+                            "bench spread: SSIM weight x {:.7}: {:.1} s, PSNR {:?}, remeshed faces {:?}, axes {:?}",
+                            r.ssim_factor,
+                            r.seconds,
+                            r.psnr_optimised,
+                            r.remeshed_faces,
+                            r.joints.iter().map(|j| j.direction).collect::<Vec<_>>()
+                        );
+                    },
+                )?;
                 out!("{}", to_json(&report)?);
                 Ok(ExitCode::SUCCESS)
             }
