@@ -77,6 +77,10 @@ const browser = await chromium.launch({
 const requests = [];
 const pageErrors = [];
 let nativeLaptopS = null;
+// The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~10 min in the
+// browser) checks the issue's 0.5° / 5 mm where the fit is conditioned well enough for it.
+const parityPreset = process.env.ARTMESH_PARITY_PRESET ?? "tiny";
+const parityMinutes = parityPreset === "tiny" ? 10 : 40;
 
 try {
   const context = await browser.newContext({ viewport: { width: 1000, height: 1100 }, acceptDownloads: true });
@@ -107,9 +111,12 @@ try {
 
   // 2. a native demo's dataset fitted in the page ------------------------------------------
   await step("fit a native dataset", async () => {
-    const out = join(work, "native");
-    nativeLaptopS = native(["demo", "--preset", "tiny", "--category", "laptop", "--parts", "1", "--seed", "3", "--out", out]);
-    console.log(`native demo (laptop, 1 part, tiny): ${nativeLaptopS.toFixed(1)} s`);
+    // ARTMESH_PARITY_NATIVE: a folder that same `artmesh demo` already wrote (saves minutes at fast).
+    const out = process.env.ARTMESH_PARITY_NATIVE ?? join(work, "native");
+    if (!process.env.ARTMESH_PARITY_NATIVE) {
+      nativeLaptopS = native(["demo", "--preset", parityPreset, "--category", "laptop", "--parts", "1", "--seed", "3", "--out", out]);
+      console.log(`native demo (laptop, 1 part, ${parityPreset}): ${nativeLaptopS.toFixed(1)} s`);
+    }
 
     await clearFlags("dataset");
     await page.setInputFiles("#folder", join(out, "dataset"));
@@ -119,7 +126,7 @@ try {
     const thumbs = await page.locator("#thumbs canvas").count();
     check(thumbs >= 2, `dataset thumbnails shown (${thumbs})`);
 
-    await page.selectOption("#fit-preset", "tiny");
+    await page.selectOption("#fit-preset", parityPreset);
     await clearFlags("fit", "preview", "result");
     const t0 = performance.now();
     await page.click("#fit-run");
@@ -128,12 +135,12 @@ try {
       if (d.state === "panic") return "panic";
       if (d.fit === "running" && d.preview === "1") return "running";
       return ["done", "error", "cancelled"].includes(d.fit) ? d.fit : false;
-    }, null, { timeout: 600_000, polling: 250 })).jsonValue();
+    }, null, { timeout: parityMinutes * 60_000, polling: 250 })).jsonValue();
     await page.screenshot({ path: artefacts + "web-fit-progress.png", fullPage: true });
     await page.locator("#fit").screenshot({ path: artefacts + "web-fit-section.png" });
     if (first === "running") check(true, "fit progress with a preview shown (artefacts/web-fit-progress.png)");
     else note(`the fit ended (${first}) before the first preview; screenshot taken after it`);
-    const left = Math.max(1000, 600_000 - (performance.now() - t0));
+    const left = Math.max(1000, parityMinutes * 60_000 - (performance.now() - t0));
     await page.waitForFunction(() => ["done", "error", "cancelled"].includes(document.body.dataset.fit) ||
       document.body.dataset.state === "panic", null, { timeout: left, polling: 500 });
     const fitS = (performance.now() - t0) / 1000;
@@ -170,7 +177,7 @@ try {
     // (natively, a 1e-6 change of the reconstruction's SSIM weight moves it 5°). So this asserts the tiny
     // fit's accuracy bound against the ground truth (< 10°, tests/articulation.rs) and prints the
     // gap against the target, which is not met.
-    const [angleTol, mmTol, motionTol] = [10, 0.02, [10, 0.02]];
+    const [angleTol, mmTol, motionTol] = parityPreset === "tiny" ? [10, 0.02, [10, 0.02]] : [0.5, 0.005, [0.5, 0.005]];
     for (let i = 0; i < nj.length; i++) {
       const a = nj[i], b = pj[i];
       const da = unit(a.direction), db = unit(b.direction);
