@@ -596,9 +596,7 @@ mod cli {
                     config.articulation.iterations = n;
                 }
                 capture::fresh_folder(&out)?;
-                let files = data::read_dir(&root).map_err(|e| e.to_string())?;
-                let dataset = Dataset::from_files(&files)
-                    .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))?;
+                let dataset = load_dataset(&root)?;
                 let id = root
                     .file_name()
                     .map_or("object".into(), |n| n.to_string_lossy().into_owned());
@@ -846,9 +844,7 @@ mod cli {
                     },
             } => {
                 let config = fit_config(&preset)?;
-                let files = data::read_dir(&root).map_err(|e| e.to_string())?;
-                let dataset = Dataset::from_files(&files)
-                    .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))?;
+                let dataset = load_dataset(&root)?;
                 let ctx = context()?;
                 let report = artmesh::bench::spread(
                     &ctx,
@@ -1060,6 +1056,13 @@ mod cli {
         Ok(config)
     }
 
+    /// Reads the dataset folder `root`; every problem found is listed in the error.
+    fn load_dataset(root: &Path) -> Result<Dataset, String> {
+        let files = data::read_dir(root).map_err(|e| e.to_string())?;
+        Dataset::from_files(&files)
+            .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))
+    }
+
     /// Loads `root`, reconstructs it with `config` (a progress bar on stderr), writes the part
     /// meshes and report.json under `out` and returns the report.
     fn reconstruct(
@@ -1067,9 +1070,7 @@ mod cli {
         out: &Path,
         config: &artmesh::fit::reconstruct::ReconstructionConfig,
     ) -> Result<eval::ReconstructionReport, String> {
-        let files = data::read_dir(root).map_err(|e| e.to_string())?;
-        let dataset = Dataset::from_files(&files)
-            .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))?;
+        let dataset = load_dataset(root)?;
         let ctx = context()?;
         let mut bar = progress::Bar::new("reconstruct");
         let reconstruction = pollster::block_on(artmesh::fit::reconstruct::reconstruct(

@@ -115,6 +115,11 @@ pub struct ArticulationConfig {
 }
 
 impl ArticulationConfig {
+    /// The step at which the joint types are decided: candidates before it, refinement after.
+    pub fn decision_step(&self) -> u32 {
+        ((self.iterations as f32 * self.decide_at) as u32).min(self.iterations)
+    }
+
     /// The articulation settings of a preset (tiny 40, fast 300, paper 20 000 steps).
     pub fn preset(preset: Preset) -> Self {
         let (iterations, report_every) = match preset {
@@ -559,7 +564,7 @@ pub async fn articulate(
     times.setup_s = now_seconds() - t0;
 
     let n = config.iterations;
-    let decide = ((n as f32 * config.decide_at) as u32).min(n);
+    let decide = config.decision_step();
     let backward_from = (n as f32 * config.backward_from) as u32;
     let mut rng = Rng::new(config.seed);
     let mut curve = Vec::new();

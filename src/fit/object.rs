@@ -51,7 +51,7 @@ impl FitConfig {
         let (fit, recover) = (rec.fit.iterations, rec.recovery_iterations);
         let per_state = f64::from(fit + recover);
         let art = self.articulation.iterations;
-        let decide = (art as f32 * self.articulation.decide_at) as u32;
+        let decide = self.articulation.decision_step();
         let total = 2.0 * per_state + f64::from(art);
         let done = if event.is_articulation() {
             2.0 * per_state
