@@ -727,11 +727,38 @@ pub fn fit(
     })
 }
 
+/// What `artmesh bench spread` changes from one fit to the next.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SpreadChange {
+    /// Fit k scales the reconstruction's SSIM weight by 1 + k·step: a change at the level of
+    /// rounding that reaches everything downstream (densification, remeshing, articulation).
+    Ssim,
+    /// One reconstruction; articulation k draws its views in another order (seed + k). The
+    /// meshes are identical, so the spread is the articulation phase's own.
+    ViewOrder,
+}
+
+impl SpreadChange {
+    /// The change named as on the command line (`ssim`, `view-order`).
+    pub fn parse(name: &str) -> Result<SpreadChange, String> {
+        match name {
+            "ssim" => Ok(SpreadChange::Ssim),
+            "view-order" => Ok(SpreadChange::ViewOrder),
+            other => Err(format!(
+                "unknown spread change {other:?}: expected ssim or view-order"
+            )),
+        }
+    }
+}
+
 /// One fit of `artmesh bench spread`.
 #[derive(Debug, Clone, Serialize)]
 pub struct SpreadRun {
     /// The factor on the reconstruction's SSIM weight (1 for the unchanged fit).
     pub ssim_factor: f64,
+    /// The articulation phase's seed (its view order).
+    pub articulation_seed: u64,
     pub seconds: f64,
     /// Per state: mean training PSNR after the optimisation and the faces remeshing built, the
     /// first numbers where two fits part ways.
@@ -750,17 +777,22 @@ pub struct JointShift {
     pub axis_line_m: Option<f64>,
     /// Part Motion between the two (° or m, in the unchanged joint's type).
     pub motion: f64,
+    /// How far the articulation's starting point (the registration seeds of the two states'
+    /// meshes) moved: axis (°). Small against `axis_deg`: the articulation phase amplified the
+    /// change; as large: it came in with the meshes.
+    pub seed_axis_deg: Option<f64>,
 }
 
-/// `artmesh bench spread` output: the same dataset fitted `runs` times, each time with the
-/// reconstruction's SSIM weight scaled by 1 + k·`step` — a change at the level of rounding —
-/// and each changed fit's joints against the unchanged one's. Two backends that round
-/// differently (lavapipe and SwiftShader, or two GPUs) can be expected to disagree by as much.
+/// `artmesh bench spread` output: the same dataset fitted `runs` times, each with a change
+/// that should not matter ([`SpreadChange`]), and each changed fit's joints against the
+/// unchanged one's. Two backends that round differently (lavapipe and SwiftShader, or two
+/// GPUs) can be expected to disagree by as much as the `ssim` change moves the joints.
 #[derive(Debug, Clone, Serialize)]
 pub struct SpreadBench {
     pub bench: &'static str,
     pub adapter: AdapterReport,
     pub preset: crate::fit::reconstruct::Preset,
+    pub change: SpreadChange,
     pub step: f64,
     pub fits: Vec<SpreadRun>,
     /// `shifts[k - 1]`: fit k's joints against fit 0's.
@@ -772,30 +804,67 @@ pub struct SpreadBench {
     pub total_s: f64,
 }
 
-/// Fits `dataset` with `config` `runs` times (see [`SpreadBench`]).
+/// Fits `dataset` with `config` `runs` times, changing `change` by `step` per fit (see
+/// [`SpreadBench`]).
 pub fn spread(
     ctx: &GpuContext,
     dataset: &crate::data::Dataset,
     config: &crate::fit::object::FitConfig,
+    change: SpreadChange,
     runs: usize,
     step: f64,
     log: &mut dyn FnMut(&SpreadRun),
 ) -> Result<SpreadBench, String> {
+    use crate::data::{GtJoint, JointKind};
     use crate::eval::joints::{axis_angle_deg, axis_line_distance, motion_error};
-    use crate::fit::object::fit_object;
+    use crate::fit::articulate::articulate;
+    use crate::fit::object::ObjectFit;
+    use crate::fit::reconstruct::reconstruct;
     let started = Instant::now();
+    let reconstruct_with = |ssim_factor: f64| {
+        let mut changed = config.reconstruction;
+        changed.fit.weights.ssim *= ssim_factor as f32;
+        pollster::block_on(reconstruct(ctx, dataset, &changed, &mut Unobserved))
+    };
+    // The view-order change shares one reconstruction.
+    let shared = match change {
+        SpreadChange::ViewOrder => {
+            Some(reconstruct_with(1.0).map_err(|e| format!("reconstruction: {e}"))?)
+        }
+        SpreadChange::Ssim => None,
+    };
     let mut fits = Vec::new();
-    let mut gt_joints = Vec::new();
+    let mut joints: Vec<(Vec<GtJoint>, Vec<Option<GtJoint>>)> = Vec::new();
     for k in 0..runs.max(2) {
-        let ssim_factor = 1.0 + k as f64 * step;
-        let mut changed = *config;
-        changed.reconstruction.fit.weights.ssim *= ssim_factor as f32;
         let start = Instant::now();
-        let fit = pollster::block_on(fit_object(ctx, dataset, &changed, &mut Unobserved))
-            .map_err(|e| format!("fit {k}: {e}"))?;
+        let (ssim_factor, seed) = match change {
+            SpreadChange::Ssim => (1.0 + k as f64 * step, config.articulation.seed),
+            SpreadChange::ViewOrder => (1.0, config.articulation.seed + k as u64),
+        };
+        let reconstruction = match &shared {
+            Some(r) => r.clone(),
+            None => reconstruct_with(ssim_factor).map_err(|e| format!("fit {k}: {e}"))?,
+        };
+        let articulation_config = crate::fit::articulate::ArticulationConfig {
+            seed,
+            ..config.articulation
+        };
+        let articulation = pollster::block_on(articulate(
+            ctx,
+            dataset,
+            &reconstruction,
+            &articulation_config,
+            &mut Unobserved,
+        ))
+        .map_err(|e| format!("fit {k}: {e}"))?;
+        let fit = ObjectFit {
+            reconstruction,
+            articulation,
+        };
         let states = &fit.reconstruction.states;
         let run = SpreadRun {
             ssim_factor,
+            articulation_seed: seed,
             seconds: start.elapsed().as_secs_f64(),
             psnr_optimised: states.iter().map(|s| s.psnr_optimised).collect(),
             remeshed_faces: states.iter().map(|s| s.remesh.faces_built).collect(),
@@ -803,22 +872,28 @@ pub fn spread(
         };
         log(&run);
         fits.push(run);
-        gt_joints.push(fit.articulation.gt_joints());
+        joints.push((fit.articulation.gt_joints(), fit.articulation.seed_joints()));
     }
-    let shifts: Vec<Vec<JointShift>> = gt_joints[1..]
+    let (first, first_seeds) = &joints[0];
+    let shifts: Vec<Vec<JointShift>> = joints[1..]
         .iter()
-        .map(|joints| {
-            gt_joints[0]
+        .map(|(fitted, seeds)| {
+            first
                 .iter()
-                .zip(joints)
+                .zip(fitted)
+                .zip(first_seeds.iter().zip(seeds))
                 .enumerate()
-                .map(|(i, (a, b))| JointShift {
+                .map(|(i, ((a, b), seed))| JointShift {
                     part: i + 1,
                     same_type: a.kind == b.kind,
                     axis_deg: axis_angle_deg(a.direction, b.direction),
-                    axis_line_m: (a.kind == crate::data::JointKind::Revolute)
+                    axis_line_m: (a.kind == JointKind::Revolute)
                         .then(|| axis_line_distance(a.origin, a.direction, b.origin, b.direction)),
                     motion: motion_error(b, a),
+                    seed_axis_deg: match seed {
+                        (Some(a), Some(b)) => Some(axis_angle_deg(a.direction, b.direction)),
+                        _ => None,
+                    },
                 })
                 .collect()
         })
@@ -828,6 +903,7 @@ pub fn spread(
         bench: "spread",
         adapter: ctx.adapter.clone(),
         preset: config.reconstruction.preset,
+        change,
         step,
         max_axis_deg: max(&|s| s.axis_deg),
         max_axis_line_m: max(&|s| s.axis_line_m.unwrap_or(0.0)),

@@ -524,6 +524,31 @@ fn demo_writes_the_twin_and_export_rewrites_it() {
     assert_eq!(shifts.len(), joints.as_array().unwrap().len());
     let worst = spread["max_axis_deg"].as_f64().unwrap();
     assert!((0.0..=90.0).contains(&worst), "{spread}");
+    // Changing only the view order shares one reconstruction: same meshes, so the same
+    // registration seeds, and another articulation seed.
+    let order = json(&artmesh(&[
+        "bench",
+        "spread",
+        &dataset,
+        "--runs",
+        "2",
+        "--vary",
+        "view-order",
+    ]));
+    assert_eq!(order["change"], "view-order");
+    let fits = order["fits"].as_array().unwrap();
+    assert_eq!(
+        fits[0]["remeshed_faces"], fits[1]["remeshed_faces"],
+        "{order}"
+    );
+    assert_eq!(
+        fits[0]["psnr_optimised"], fits[1]["psnr_optimised"],
+        "{order}"
+    );
+    assert_ne!(fits[0]["articulation_seed"], fits[1]["articulation_seed"]);
+    for shift in order["shifts"][0].as_array().unwrap() {
+        assert_eq!(shift["seed_axis_deg"].as_f64(), Some(0.0), "{order}");
+    }
     let missing = artmesh(&["bench", "spread", &tmp.join("nowhere")]);
     assert_eq!(missing.status.code(), Some(1));
     assert!(

@@ -406,6 +406,11 @@ mod cli {
             /// Fits, the unchanged one included.
             #[arg(long, default_value_t = 4, value_parser = clap::value_parser!(u32).range(2..=100))]
             runs: u32,
+            /// What changes between fits: `ssim` scales the reconstruction's SSIM weight by
+            /// 1 + k·step (reaches meshes and joints); `view-order` keeps one reconstruction
+            /// and changes the articulation's view order (its own spread).
+            #[arg(long, default_value = "ssim", value_parser = ["ssim", "view-order"])]
+            vary: String,
             /// Relative change of the SSIM weight per fit.
             #[arg(long, default_value_t = 1e-6)]
             step: f64,
@@ -840,22 +845,26 @@ mod cli {
                         dataset: root,
                         preset,
                         runs,
+                        vary,
                         step,
                     },
             } => {
                 let config = fit_config(&preset)?;
+                let change = artmesh::bench::SpreadChange::parse(&vary)?;
                 let dataset = load_dataset(&root)?;
                 let ctx = context()?;
                 let report = artmesh::bench::spread(
                     &ctx,
                     &dataset,
                     &config,
+                    change,
                     runs as usize,
                     step,
                     &mut |r| {
                         eprintln!(
-                            "bench spread: SSIM weight x {:.7}: {:.1} s, PSNR {:?}, remeshed faces {:?}, axes {:?}",
+                            "bench spread: SSIM weight x {:.7}, articulation seed {}: {:.1} s, PSNR {:?}, remeshed faces {:?}, axes {:?}",
                             r.ssim_factor,
+                            r.articulation_seed,
                             r.seconds,
                             r.psnr_optimised,
                             r.remeshed_faces,

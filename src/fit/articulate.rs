@@ -217,6 +217,23 @@ impl Articulation {
     pub fn gt_joints(&self) -> Vec<GtJoint> {
         self.joints.iter().map(|j| j.joint).collect()
     }
+
+    /// Where the refinement started: per joint its registration seed of the fitted type, read
+    /// as a joint like [`Self::gt_joints`] (`None` for a part seen in only one state).
+    pub fn seed_joints(&self) -> Vec<Option<GtJoint>> {
+        let center = self.center.as_dvec3();
+        self.joints
+            .iter()
+            .map(|j| {
+                let c = j.initial.as_ref()?;
+                let seed = match j.kind {
+                    JointKind::Revolute => c.revolute,
+                    JointKind::Prismatic => c.prismatic,
+                };
+                Some(seed.joint(j.kind, center))
+            })
+            .collect()
+    }
 }
 
 /// What every articulation render shares: the rasterizer and motion kernels, the render
