@@ -252,6 +252,17 @@ impl Default for MotionRates {
     }
 }
 
+impl MotionRates {
+    /// Every rate multiplied by `factor`.
+    pub fn scaled(self, factor: f64) -> Self {
+        Self {
+            rotation: self.rotation * factor,
+            translation: self.translation * factor,
+            pivot: self.pivot * factor,
+        }
+    }
+}
+
 /// Adam over the motions of all parts: ten numbers per part (q, P, T), ε as the field's Adam.
 #[derive(Debug, Clone)]
 pub struct MotionAdam {

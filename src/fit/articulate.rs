@@ -11,7 +11,9 @@
 //!    (ties to revolute, as in the paper). The winner's Adam moments start from zero.
 //! 3. **Refine**: the winners with type-masked gradients, the backward pixel-wise term (state
 //!    t₂'s mesh moved by the analytic inverse g⁻, rendered from state-t₁ cameras) from
-//!    `backward_from`, and the vertex-wise term in both directions.
+//!    `backward_from`, and the vertex-wise term in both directions. Each step's pixel-wise
+//!    gradients come from one view per direction (the paper) or from all of them
+//!    ([`RefineViews`]).
 //!
 //! The pixel-wise gradients come back as per-part [`PartSums`] from the GPU
 //! ([`MovedMesh::read_sums`]), the vertex-wise ones from the CPU; [`PartMotion::gradient`] turns
@@ -81,6 +83,16 @@ impl Ablation {
     }
 }
 
+/// How many views one refinement step's pixel-wise gradients average, per direction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RefineViews {
+    /// The next view of a shuffled cycle: the paper's stochastic steps.
+    One,
+    /// Every view: the full-batch gradient, as many renders per step as the state has views.
+    All,
+}
+
 /// Schedule, weights and learning rates of the articulation phase.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ArticulationConfig {
@@ -101,7 +113,13 @@ pub struct ArticulationConfig {
     pub gamma: f32,
     pub opacity_floor: f32,
     pub vertex: VertexMotionWeights,
+    /// The candidates' rates.
     pub rates: MotionRates,
+    /// The refinement's rates.
+    pub refine_rates: MotionRates,
+    /// Views per refinement step. At 32–64 px the objective has local minima a degree or more
+    /// apart, and with single-view steps their noise picks which one a fit ends in.
+    pub refine_views: RefineViews,
     /// Each stage (candidates, refine) decays the rates log-linearly to this fraction of
     /// themselves (1 = the paper's constant rates). Ours: with a few hundred single-view steps
     /// instead of 20 000, constant rates leave Adam's per-step jitter (≈ one rate per step) in
@@ -115,17 +133,37 @@ pub struct ArticulationConfig {
 }
 
 impl ArticulationConfig {
+    /// Renders per refinement step, both directions, for states of `views` training views.
+    pub fn refine_renders(&self, views: usize) -> usize {
+        match self.refine_views {
+            RefineViews::One => 2,
+            RefineViews::All => 2 * views.max(1),
+        }
+    }
+
     /// The step at which the joint types are decided: candidates before it, refinement after.
     pub fn decision_step(&self) -> u32 {
         ((self.iterations as f32 * self.decide_at) as u32).min(self.iterations)
     }
 
     /// The articulation settings of a preset (tiny 40, fast 300, paper 20 000 steps).
+    ///
+    /// `tiny` and `fast` train at a quarter of the paper's rates and refine on every view: with
+    /// one view per step and the paper's rates, changes that should not matter (the SSIM weight
+    /// × (1 + 1e-6), SwiftShader's rounding instead of lavapipe's) moved the fast laptop's axis
+    /// by up to 1.4° and its motion by 2.3°; now by 0.13° and 0.26° (`bench spread`, README
+    /// "Browser app"), at about three times the fit's time. Keeping the paper's rates for the
+    /// candidates brought that back to 2.1°. `paper` keeps the paper's 20 000 single-view steps
+    /// at full rates (every one of 100 views per step would cost 100×).
     pub fn preset(preset: Preset) -> Self {
         let (iterations, report_every) = match preset {
             Preset::Tiny => (40, 5),
             Preset::Fast => (300, 20),
             Preset::Paper => (20_000, 200),
+        };
+        let (refine_views, rate_factor) = match preset {
+            Preset::Tiny | Preset::Fast => (RefineViews::All, 0.25),
+            Preset::Paper => (RefineViews::One, 1.0),
         };
         Self {
             iterations,
@@ -139,7 +177,9 @@ impl ArticulationConfig {
             gamma: 1.0,
             opacity_floor: 0.0,
             vertex: VertexMotionWeights::default(),
-            rates: MotionRates::default(),
+            rates: MotionRates::default().scaled(rate_factor),
+            refine_rates: MotionRates::default().scaled(rate_factor),
+            refine_views,
             final_rate: 0.05,
             ablation: Ablation::FULL,
             report_every,
@@ -180,7 +220,8 @@ pub struct FittedJoint {
 pub struct ArticulationPoint {
     pub iteration: u32,
     pub phase: Phase,
-    /// Forward pixel-wise loss of this step's view.
+    /// Forward pixel-wise loss of this step's view (the mean over the views when the
+    /// refinement uses them all).
     pub forward_loss: f32,
     /// Backward pixel-wise loss, when on.
     pub backward_loss: Option<f32>,
@@ -295,6 +336,46 @@ impl<'a> MovedView<'a> {
     ) -> GpuResult<Vec<PartSums>> {
         let view = self.views.next(self.frames.len(), rng);
         self.gradient(ctx, r, motions, view).await
+    }
+
+    /// A refinement step's per-part sums from one view of the cycle or the mean over every view,
+    /// with the loss (the same mean) when `read_loss`.
+    async fn refine_step(
+        &mut self,
+        ctx: &GpuContext,
+        r: &MotionRenderer,
+        motions: &[(DMat3, DVec3)],
+        views: RefineViews,
+        rng: &mut Rng,
+        read_loss: bool,
+    ) -> GpuResult<(Vec<PartSums>, Option<f32>)> {
+        if views == RefineViews::One {
+            let sums = self.step(ctx, r, motions, rng).await?;
+            return Ok((sums, self.read_loss(ctx, read_loss).await?));
+        }
+        let n = self.frames.len();
+        let (mut sums, mut total) = (Vec::new(), 0.0);
+        for view in 0..n {
+            let s = self.gradient(ctx, r, motions, view).await?;
+            sums = if sums.is_empty() {
+                s
+            } else {
+                sums.into_iter().zip(s).map(|(a, b)| a.merged(b)).collect()
+            };
+            total += self.read_loss(ctx, read_loss).await?.unwrap_or(0.0);
+        }
+        let mean = 1.0 / n.max(1) as f64;
+        let sums = sums.into_iter().map(|s| s.scaled(mean)).collect();
+        Ok((sums, read_loss.then(|| total / n.max(1) as f32)))
+    }
+
+    /// The last render's total loss, when `read` (a GPU readback).
+    async fn read_loss(&self, ctx: &GpuContext, read: bool) -> GpuResult<Option<f32>> {
+        Ok(if read {
+            Some(self.loss.read_terms(ctx).await?.total)
+        } else {
+            None
+        })
     }
 
     /// The loss of view `view` with the mesh moved by `motions` (terms left in the loss's
@@ -718,7 +799,7 @@ pub async fn articulate(
 
     // 3. Refine the winners, fresh moments, type-masked.
     let t_refine = now_seconds();
-    let mut adam = MotionAdam::new(k, config.rates);
+    let mut adam = MotionAdam::new(k, config.refine_rates);
     let vertex = VertexMotionWeights {
         color: if config.ablation.vertex_color {
             config.vertex.color
@@ -743,12 +824,19 @@ pub async fn articulate(
         );
         // This step's affine maps, both directions, shared by the pixel- and vertex-wise terms.
         let (g_fwd, g_bwd) = (forward_maps(&motions), backward_maps(&motions));
-        let sums_f = forward.step(ctx, &renderer, &g_fwd, &mut rng).await?;
+        let step = i - decide;
+        let report = (step + 1).is_multiple_of(config.report_every.max(1)) || i + 1 == n;
+        let views = config.refine_views;
+        let (sums_f, forward_loss) = forward
+            .refine_step(ctx, &renderer, &g_fwd, views, &mut rng, report)
+            .await?;
         let with_backward = config.ablation.backward && i >= backward_from;
-        let sums_b = if with_backward {
-            backward.step(ctx, &renderer, &g_bwd, &mut rng).await?
+        let (sums_b, backward_loss) = if with_backward {
+            backward
+                .refine_step(ctx, &renderer, &g_bwd, views, &mut rng, report)
+                .await?
         } else {
-            vec![PartSums::default(); k]
+            (vec![PartSums::default(); k], None)
         };
         let mut vertex_loss = None;
         let (mut vf, mut vb) = (vec![PartSums::default(); k], vec![PartSums::default(); k]);
@@ -775,24 +863,17 @@ pub async fn articulate(
             let g = motions[part].gradient(&fw, &bw);
             adam.step(part, &mut motions[part], &g, MotionMask::of(kinds[part]));
         }
-        let step = i - decide;
-        if (step + 1).is_multiple_of(config.report_every.max(1)) || i + 1 == n {
-            let terms = forward.loss.read_terms(ctx).await?;
-            let backward_loss = if with_backward {
-                Some(backward.loss.read_terms(ctx).await?.total)
-            } else {
-                None
-            };
+        if let (true, Some(forward_loss)) = (report, forward_loss) {
             curve.push(ArticulationPoint {
                 iteration: i,
                 phase: Phase::Refine,
-                forward_loss: terms.total,
+                forward_loss,
                 backward_loss,
                 vertex_loss,
             });
             checkpoint(
                 observer,
-                &event(Phase::Refine, step + 1, refine, Some(terms.total)),
+                &event(Phase::Refine, step + 1, refine, Some(forward_loss)),
             )
             .await?;
         }

@@ -17,7 +17,8 @@ import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 
-const TOTAL_MINUTES = 25;
+// The whole run's limit: the fast parity fit alone takes ~25 min in the browser here.
+const TOTAL_MINUTES = (process.env.ARTMESH_PARITY_PRESET ?? "tiny") === "tiny" ? 25 : 60;
 let failed = 0, passed = 0;
 const check = (ok, what) => {
   console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
@@ -77,10 +78,10 @@ const browser = await chromium.launch({
 const requests = [];
 const pageErrors = [];
 let nativeLaptopS = null;
-// The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~10 min in the
-// browser) asserts the issue's 0.5° / 5 mm (not met there either; README "Browser app").
+// The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25 min in the
+// browser) asserts the issue's 0.5° / 5 mm (README "Browser app").
 const parityPreset = process.env.ARTMESH_PARITY_PRESET ?? "tiny";
-const parityMinutes = parityPreset === "tiny" ? 10 : 40;
+const parityMinutes = parityPreset === "tiny" ? 10 : 50;
 
 try {
   const context = await browser.newContext({ viewport: { width: 1000, height: 1100 }, acceptDownloads: true });
@@ -172,11 +173,11 @@ try {
     if (!check(pj.length === nj.length && types(pj) === types(nj),
       `page joints match native in number and type (page ${types(pj)}; native ${types(nj)})`)) return;
     // The issue asks for 0.5° / 5 mm. Both fits repeat to the digit, but SwiftShader and lavapipe
-    // round differently (PSNRs agree to ~1e-4 dB after optimisation); remeshing turns that into a
-    // few faces' difference, and the articulation at 32 px / 4 views turns those into ~3° of axis
-    // (natively, a 1e-6 change of the reconstruction's SSIM weight moves it 6.3°). So this asserts the tiny
-    // fit's accuracy bound against the ground truth (< 10°, tests/articulation.rs) and prints the
-    // gap against the target, which is not met.
+    // round differently (PSNRs agree to ~1e-4 dB after optimisation) and remeshing turns that into
+    // a few faces' difference. At fast the articulation keeps the joints within the target; at
+    // tiny (32 px, 4 views) it cannot (natively, a 1e-6 change of the reconstruction's SSIM weight
+    // moves the tiny axis up to 2.3°), so tiny asserts its accuracy bound against the ground truth
+    // (< 10°, tests/articulation.rs) and prints the gap against the target.
     const [angleTol, mmTol, motionTol] = parityPreset === "tiny" ? [10, 0.02, [10, 0.02]] : [0.5, 0.005, [0.5, 0.005]];
     for (let i = 0; i < nj.length; i++) {
       const a = nj[i], b = pj[i];
