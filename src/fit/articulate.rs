@@ -113,10 +113,7 @@ pub struct ArticulationConfig {
     pub gamma: f32,
     pub opacity_floor: f32,
     pub vertex: VertexMotionWeights,
-    /// The candidates' rates.
     pub rates: MotionRates,
-    /// The refinement's rates.
-    pub refine_rates: MotionRates,
     /// Views per refinement step. At 32–64 px the objective has local minima a degree or more
     /// apart, and with single-view steps their noise picks which one a fit ends in.
     pub refine_views: RefineViews,
@@ -178,7 +175,6 @@ impl ArticulationConfig {
             opacity_floor: 0.0,
             vertex: VertexMotionWeights::default(),
             rates: MotionRates::default().scaled(rate_factor),
-            refine_rates: MotionRates::default().scaled(rate_factor),
             refine_views,
             final_rate: 0.05,
             ablation: Ablation::FULL,
@@ -366,7 +362,7 @@ impl<'a> MovedView<'a> {
         }
         let mean = 1.0 / n.max(1) as f64;
         let sums = sums.into_iter().map(|s| s.scaled(mean)).collect();
-        Ok((sums, read_loss.then(|| total / n.max(1) as f32)))
+        Ok((sums, read_loss.then_some(total * mean as f32)))
     }
 
     /// The last render's total loss, when `read` (a GPU readback).
@@ -799,7 +795,7 @@ pub async fn articulate(
 
     // 3. Refine the winners, fresh moments, type-masked.
     let t_refine = now_seconds();
-    let mut adam = MotionAdam::new(k, config.refine_rates);
+    let mut adam = MotionAdam::new(k, config.rates);
     let vertex = VertexMotionWeights {
         color: if config.ablation.vertex_color {
             config.vertex.color
@@ -863,7 +859,8 @@ pub async fn articulate(
             let g = motions[part].gradient(&fw, &bw);
             adam.step(part, &mut motions[part], &g, MotionMask::of(kinds[part]));
         }
-        if let (true, Some(forward_loss)) = (report, forward_loss) {
+        // Read back only on report steps.
+        if let Some(forward_loss) = forward_loss {
             curve.push(ArticulationPoint {
                 iteration: i,
                 phase: Phase::Refine,

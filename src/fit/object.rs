@@ -54,7 +54,7 @@ impl FitConfig {
         let per_state = 2.0 * f64::from(fit + recover);
         let art = &self.articulation;
         let decide = art.decision_step();
-        let refine_step = art.refine_renders(rec.max_views.max(1)) as f64;
+        let refine_step = art.refine_renders(rec.max_views) as f64;
         let refine = f64::from(art.iterations - decide) * refine_step;
         let total = 2.0 * per_state + f64::from(decide) + refine;
         let done = if event.is_articulation() {
