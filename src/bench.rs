@@ -765,6 +765,12 @@ pub struct SpreadRun {
     pub psnr_optimised: Vec<f64>,
     pub remeshed_faces: Vec<usize>,
     pub joints: Vec<crate::fit::object::JointRecord>,
+    /// Against the dataset's ground truth (`None` without one): the fitted joints' errors, and
+    /// those of the registration seeds the refinement started from (`None` when a part has no
+    /// seed), matched as `artmesh eval` matches them. Shows whether the fits scatter around the
+    /// truth or away from it, and what the refinement added to its seeds.
+    pub gt_errors: Option<Vec<crate::eval::joints::JointPairMetrics>>,
+    pub seed_gt_errors: Option<Vec<crate::eval::joints::JointPairMetrics>>,
 }
 
 /// How far one part's joint moved in a changed fit from the unchanged one.
@@ -816,7 +822,7 @@ pub fn spread(
     log: &mut dyn FnMut(&SpreadRun),
 ) -> Result<SpreadBench, String> {
     use crate::data::{GtJoint, JointKind};
-    use crate::eval::joints::{axis_angle_deg, axis_line_distance, motion_error};
+    use crate::eval::joints::{axis_angle_deg, axis_line_distance, match_joints, motion_error};
     use crate::fit::articulate::articulate;
     use crate::fit::object::ObjectFit;
     use crate::fit::reconstruct::reconstruct;
@@ -862,6 +868,16 @@ pub fn spread(
             articulation,
         };
         let states = &fit.reconstruction.states;
+        let (fitted, seeds) = (fit.articulation.gt_joints(), fit.articulation.seed_joints());
+        let against_gt = |joints: &[GtJoint]| {
+            let gt = dataset.gt_joints.as_ref()?;
+            match_joints(joints, gt).ok().map(|m| m.pairs)
+        };
+        let seeds_gt = seeds
+            .iter()
+            .copied()
+            .collect::<Option<Vec<GtJoint>>>()
+            .and_then(|s| against_gt(&s));
         let run = SpreadRun {
             ssim_factor,
             articulation_seed: seed,
@@ -869,10 +885,12 @@ pub fn spread(
             psnr_optimised: states.iter().map(|s| s.psnr_optimised).collect(),
             remeshed_faces: states.iter().map(|s| s.remesh.faces_built).collect(),
             joints: fit.joint_records(),
+            gt_errors: against_gt(&fitted),
+            seed_gt_errors: seeds_gt,
         };
         log(&run);
         fits.push(run);
-        joints.push((fit.articulation.gt_joints(), fit.articulation.seed_joints()));
+        joints.push((fitted, seeds));
     }
     let (first, first_seeds) = &joints[0];
     let shifts: Vec<Vec<JointShift>> = joints[1..]

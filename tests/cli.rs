@@ -524,6 +524,37 @@ fn demo_writes_the_twin_and_export_rewrites_it() {
     assert_eq!(shifts.len(), joints.as_array().unwrap().len());
     let worst = spread["max_axis_deg"].as_f64().unwrap();
     assert!((0.0..=90.0).contains(&worst), "{spread}");
+    // The demo has ground truth: every fit is scored against it, and the unchanged fit is the
+    // demo's own fit, so it scores what the demo's report says.
+    let report: serde_json::Value =
+        serde_json::from_slice(&std::fs::read(format!("{fit}/report.json")).unwrap()).unwrap();
+    let scored = report["metrics"]["joints"].as_array().unwrap();
+    for run in spread["fits"].as_array().unwrap() {
+        assert_eq!(
+            run["gt_errors"].as_array().map(Vec::len),
+            Some(scored.len()),
+            "{run}"
+        );
+        assert_eq!(
+            run["seed_gt_errors"].as_array().map(Vec::len),
+            Some(scored.len()),
+            "{run}"
+        );
+    }
+    for (fitted, demo) in spread["fits"][0]["gt_errors"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .zip(scored)
+    {
+        for metric in ["axis_ang", "part_motion"] {
+            let (a, b) = (
+                fitted[metric].as_f64().unwrap(),
+                demo[metric].as_f64().unwrap(),
+            );
+            assert!((a - b).abs() < 1e-9, "{metric}: spread {a}, demo {b}");
+        }
+    }
     // Changing only the view order shares one reconstruction: same meshes, so the same
     // registration seeds, and another articulation seed.
     let order = json(&artmesh(&[

@@ -861,14 +861,25 @@ mod cli {
                     runs as usize,
                     step,
                     &mut |r| {
+                        // Per joint against GT: axis angle (°) / Part Motion, fit then seed.
+                        let errors = |e: &Option<Vec<artmesh::eval::joints::JointPairMetrics>>| {
+                            e.as_ref().map_or("-".to_string(), |pairs| {
+                                let each = pairs
+                                    .iter()
+                                    .map(|p| format!("{:.3}/{:.3}", p.axis_ang, p.part_motion));
+                                each.collect::<Vec<_>>().join(" ")
+                            })
+                        };
                         eprintln!(
-                            "bench spread: SSIM weight x {:.7}, articulation seed {}: {:.1} s, PSNR {:?}, remeshed faces {:?}, axes {:?}",
+                            "bench spread: SSIM weight x {:.7}, articulation seed {}: {:.1} s, PSNR {:?}, remeshed faces {:?}, axes {:?}, GT error (axis/motion) {} (seeds {})",
                             r.ssim_factor,
                             r.articulation_seed,
                             r.seconds,
                             r.psnr_optimised,
                             r.remeshed_faces,
-                            r.joints.iter().map(|j| j.direction).collect::<Vec<_>>()
+                            r.joints.iter().map(|j| j.direction).collect::<Vec<_>>(),
+                            errors(&r.gt_errors),
+                            errors(&r.seed_gt_errors),
                         );
                     },
                 )?;
