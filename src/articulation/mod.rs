@@ -1,7 +1,8 @@
 //! The articulation phase's rigid-motion maths (paper §3.2): per-part motions with their analytic
 //! inverse, the per-part gradient sums both consistency terms reduce to, and the vertex-wise
-//! motion consistency on the CPU.
+//! motion consistency on the CPU, and the joint magnitude's registration along the fitted axis.
 
+pub mod axis_registration;
 pub mod init;
 pub mod kernels;
 pub mod motion;

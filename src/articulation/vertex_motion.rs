@@ -202,6 +202,16 @@ impl StateSurface {
     pub fn cross_part_faces(&self) -> usize {
         self.cross_part_faces
     }
+
+    /// The point of `part`'s faces closest to `q` and that face's unit normal (either side);
+    /// `None` for a part without faces or when the closest face is degenerate.
+    pub fn closest_with_normal(&self, part: usize, q: DVec3) -> Option<(DVec3, DVec3)> {
+        let hit = self.part_trees.get(part)?.closest(q.as_vec3())?;
+        let face = self.faces[self.part_faces[part][hit.face as usize] as usize];
+        let [a, b, c] = face.map(|v| self.positions[v as usize].as_dvec3());
+        let normal = (b - a).cross(c - a).try_normalize()?;
+        Some((hit.point.as_dvec3(), normal))
+    }
 }
 
 /// The weights of the vertex-wise term: λ_c, λ_σ and the validity threshold η.

@@ -1022,8 +1022,14 @@ mod cli {
             } else {
                 " m"
             };
+            let registered = match j.axis_registration {
+                Some(r) if r.applied => {
+                    format!(", registered along the axis from {:.3}{unit}", r.fitted)
+                }
+                _ => String::new(),
+            };
             eprintln!(
-                "fit: part {}: {:?} joint, axis {:.3?} through {:.3?}, motion {:.3}{unit} (bake-off losses {:.4?})",
+                "fit: part {}: {:?} joint, axis {:.3?} through {:.3?}, motion {:.3}{unit}{registered} (bake-off losses {:.4?})",
                 j.part, j.kind, j.direction, j.origin, j.motion, j.bake_off
             );
         }

@@ -112,6 +112,9 @@ pub struct JointRecord {
     pub limits: [f32; 2],
     /// The bake-off's masked losses (revolute, prismatic).
     pub bake_off: [Option<f64>; 2],
+    /// The magnitude before and after its registration along the axis (absent when off).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub axis_registration: Option<crate::articulation::axis_registration::AxisRegistration>,
     /// The fitted start → end motion g⁺ of the part as a 4 × 4 matrix, rows first (world frame).
     pub end_transform: [[f64; 4]; 4],
 }
@@ -143,6 +146,7 @@ impl ObjectFit {
                     motion,
                     limits: [motion.min(0.0), motion.max(0.0)],
                     bake_off: [j.bake_off.revolute_loss, j.bake_off.prismatic_loss],
+                    axis_registration: j.axis_registration,
                     end_transform: [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]],
                 }
             })
