@@ -18,7 +18,7 @@
 use glam::{DMat3, DQuat, DVec3};
 use serde::Serialize;
 
-use super::motion::{PartMotion, rotation_axis_angle};
+use super::motion::PartMotion;
 use super::vertex_motion::StateSurface;
 use crate::data::JointKind;
 
@@ -70,17 +70,8 @@ impl AxisFamily {
     /// The family through `motion` and its current s; `None` when the motion has no direction
     /// to follow (a zero rotation or translation).
     fn new(motion: PartMotion, kind: JointKind) -> Option<(Self, f64)> {
-        let (axis, s) = match kind {
-            JointKind::Revolute => {
-                let (axis, angle) = rotation_axis_angle(motion.rotation);
-                (axis, angle)
-            }
-            JointKind::Prismatic => {
-                let d = motion.translation.length();
-                (motion.translation / d, d)
-            }
-        };
-        (s > 1e-9 && axis.is_finite()).then_some((Self { motion, kind, axis }, s))
+        let (axis, s) = motion.axis_and_magnitude(kind);
+        (s > 1e-9).then_some((Self { motion, kind, axis }, s))
     }
 
     /// The motion at s.
@@ -204,7 +195,8 @@ pub fn register_along_axis(
         .iter()
         .fold((0.0, 0.0), |(a, b), r| (a + r.dr * r.dr, b + r.speed2));
     let observability = seen / moved.max(f64::MIN_POSITIVE);
-    let (mut s, mut res, mut iterations) = (s0, first.clone(), 0);
+    let rms_before = rms(&first);
+    let (mut s, mut res, mut iterations) = (s0, first, 0);
     while observability >= MIN_OBSERVABILITY && iterations < ITERATIONS {
         iterations += 1;
         let (num, den) = res
@@ -228,7 +220,7 @@ pub fn register_along_axis(
         JointKind::Revolute => v.to_degrees(),
         JointKind::Prismatic => v,
     };
-    let (rms_before, rms_after) = (rms(&first), rms(&res));
+    let rms_after = rms(&res);
     // Not worse than the fitted magnitude: trimming renews the matches, so this is not a given.
     // (A threshold here would switch the registration off for fits already close to its
     // optimum, the very ones that should agree with each other.)
@@ -249,7 +241,26 @@ pub fn register_along_axis(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::articulation::motion::rotation_axis_angle;
     use glam::Vec3;
+
+    /// A surface whose every vertex is part 1 of 2, its positions carried by `motion`.
+    fn part_one(positions: &[Vec3], faces: Vec<[u32; 3]>, motion: &PartMotion) -> StateSurface {
+        let positions: Vec<Vec3> = positions
+            .iter()
+            .map(|p| motion.forward(p.as_dvec3()).as_vec3())
+            .collect();
+        let count = positions.len();
+        StateSurface::new(
+            positions,
+            faces,
+            vec![1; count],
+            vec![Vec3::ONE; count],
+            vec![1.0; count],
+            2,
+        )
+        .unwrap()
+    }
 
     /// A closed box (a door slab or a drawer) of `size` at `min`, subdivided `n` times per edge,
     /// all part 1 of 2, carried by `motion`.
@@ -267,7 +278,7 @@ mod tests {
                         p[axis] += size[axis] * side as f32;
                         p[ua] += size[ua] * i as f32 / n as f32;
                         p[va] += size[va] * j as f32 / n as f32;
-                        positions.push(motion.forward(p.as_dvec3()).as_vec3());
+                        positions.push(p);
                     }
                 }
                 for j in 0..n {
@@ -279,16 +290,7 @@ mod tests {
                 }
             }
         }
-        let count = positions.len();
-        StateSurface::new(
-            positions,
-            faces,
-            vec![1; count],
-            vec![Vec3::ONE; count],
-            vec![1.0; count],
-            2,
-        )
-        .unwrap()
+        part_one(&positions, faces, motion)
     }
 
     #[test]
@@ -345,20 +347,7 @@ mod tests {
                 [a, b + 1, a + 1],
             ]);
         }
-        let positions: Vec<Vec3> = positions
-            .iter()
-            .map(|p| motion.forward(p.as_dvec3()).as_vec3())
-            .collect();
-        let count = positions.len();
-        StateSurface::new(
-            positions,
-            faces,
-            vec![1; count],
-            vec![Vec3::ONE; count],
-            vec![1.0; count],
-            2,
-        )
-        .unwrap()
+        part_one(&positions, faces, motion)
     }
 
     #[test]

@@ -119,24 +119,12 @@ impl PartMotion {
         }
     }
 
-    /// The motion read as a joint in the ground-truth file's conventions: a revolute joint's axis
-    /// through the point of the rotation axis closest to `center`, its angle in degrees; a
-    /// prismatic joint's unit direction and distance in metres (origin at `center`). The start
-    /// value is 0, the end value the motion.
-    pub fn joint(&self, kind: JointKind, center: DVec3) -> GtJoint {
+    /// The joint's unit axis and magnitude: a revolute motion's rotation axis and angle
+    /// (radians, in [0, π]), a prismatic one's slide direction and distance (m). A motion too
+    /// small to have a direction gets the z axis and (about) 0.
+    pub fn axis_and_magnitude(&self, kind: JointKind) -> (DVec3, f64) {
         match kind {
-            JointKind::Revolute => {
-                let (axis, angle) = rotation_axis_angle(self.rotation);
-                // Points on the axis are fixed by g⁺ − T; the pivot is one of them.
-                let origin = closest_on_line(self.pivot, axis, center);
-                GtJoint {
-                    kind,
-                    origin: origin.as_vec3(),
-                    direction: axis.as_vec3(),
-                    start: 0.0,
-                    end: angle.to_degrees() as f32,
-                }
-            }
+            JointKind::Revolute => rotation_axis_angle(self.rotation),
             JointKind::Prismatic => {
                 let d = self.translation.length();
                 let direction = if d > 1e-12 {
@@ -144,14 +132,31 @@ impl PartMotion {
                 } else {
                     DVec3::Z
                 };
-                GtJoint {
-                    kind,
-                    origin: center.as_vec3(),
-                    direction: direction.as_vec3(),
-                    start: 0.0,
-                    end: d as f32,
-                }
+                (direction, d)
             }
+        }
+    }
+
+    /// The motion read as a joint in the ground-truth file's conventions: a revolute joint's axis
+    /// through the point of the rotation axis closest to `center`, its angle in degrees; a
+    /// prismatic joint's unit direction and distance in metres (origin at `center`). The start
+    /// value is 0, the end value the motion.
+    pub fn joint(&self, kind: JointKind, center: DVec3) -> GtJoint {
+        let (axis, magnitude) = self.axis_and_magnitude(kind);
+        let (origin, end) = match kind {
+            // Points on the axis are fixed by g⁺ − T; the pivot is one of them.
+            JointKind::Revolute => (
+                closest_on_line(self.pivot, axis, center),
+                magnitude.to_degrees(),
+            ),
+            JointKind::Prismatic => (center, magnitude),
+        };
+        GtJoint {
+            kind,
+            origin: origin.as_vec3(),
+            direction: axis.as_vec3(),
+            start: 0.0,
+            end: end as f32,
         }
     }
 }
