@@ -431,6 +431,7 @@ fn capture_entry(
     entry: &crate::synth::SuiteEntry,
     size: u32,
     views: usize,
+    test_views: usize,
 ) -> Result<crate::data::Dataset, String> {
     let id = entry.id();
     let object = crate::synth::generate(&entry.params()).map_err(|e| format!("{id}: {e}"))?;
@@ -438,7 +439,7 @@ fn capture_entry(
         width: size,
         height: size,
         train_views: views,
-        test_views: 0,
+        test_views,
         seed: entry.seed,
         ..crate::render::RenderSpec::default()
     };
@@ -469,7 +470,7 @@ pub fn reconstruct(
         if !only.is_empty() && !only.iter().any(|o| id.contains(o.as_str())) {
             continue;
         }
-        let dataset = capture_entry(ctx, &entry, size, views)?;
+        let dataset = capture_entry(ctx, &entry, size, views, 0)?;
         let start = Instant::now();
         let reconstruction = pollster::block_on(crate::fit::reconstruct::reconstruct(
             ctx,
@@ -515,7 +516,7 @@ pub fn reconstruct(
 #[derive(Debug, Clone, Serialize)]
 pub struct FitObject {
     pub id: String,
-    pub category: &'static str,
+    pub category: String,
     pub parts: usize,
     /// Wall time of the whole fit, and of its two phases.
     pub seconds: f64,
@@ -539,7 +540,7 @@ pub struct AblationRun {
 pub struct FitBench {
     pub bench: &'static str,
     pub adapter: AdapterReport,
-    pub suite: &'static str,
+    pub suite: SuiteSource,
     pub config: crate::fit::object::FitConfig,
     pub capture: CaptureSettings,
     pub objects: Vec<FitObject>,
@@ -573,18 +574,134 @@ const ARTICULATION_ABLATIONS: [(&str, &str); 3] = [
     ("w/o BackwardPass", "no-backward"),
 ];
 
-/// Fits the suite's objects (all, or those whose id contains one of `only`), each captured in
-/// memory at `size`² with `views` training views per state, and scores them. With `ablations`,
-/// each object's reconstruction is also re-articulated without each consistency component, and
-/// reconstructed and articulated once more with global remeshing.
-#[allow(clippy::too_many_arguments)]
+/// Where `artmesh bench fit` takes its objects from.
+#[derive(Debug, Clone, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SuiteSource {
+    /// A suite folder written by `artmesh suite` (suite.json and one dataset folder per id):
+    /// the objects as a user would hand them over.
+    Dir(std::path::PathBuf),
+    /// The plan captured in memory at `size`² with `views` training and 2 test views per state:
+    /// CI-sized runs only.
+    Capture {
+        kind: crate::synth::SuiteKind,
+        size: u32,
+        views: usize,
+    },
+}
+
+/// One object listed by a [`SuiteSource`].
+struct SourceObject {
+    id: String,
+    category: String,
+    entry: Option<crate::synth::SuiteEntry>,
+}
+
+impl SuiteSource {
+    /// The objects, in suite order, and how they were captured.
+    fn objects(&self) -> Result<(Vec<SourceObject>, CaptureSettings), String> {
+        match self {
+            SuiteSource::Capture { kind, size, views } => Ok((
+                kind.plan()
+                    .into_iter()
+                    .map(|e| SourceObject {
+                        id: e.id(),
+                        category: e.category.to_string(),
+                        entry: Some(e),
+                    })
+                    .collect(),
+                CaptureSettings {
+                    size: *size,
+                    train_views: *views,
+                },
+            )),
+            SuiteSource::Dir(dir) => {
+                let path = dir.join("suite.json");
+                let text = std::fs::read_to_string(&path)
+                    .map_err(|e| format!("{}: {e}", path.display()))?;
+                #[derive(serde::Deserialize)]
+                struct Manifest {
+                    objects: Vec<Entry>,
+                    capture: Capture,
+                }
+                #[derive(serde::Deserialize)]
+                struct Capture {
+                    width: u32,
+                    train_views: usize,
+                }
+                #[derive(serde::Deserialize)]
+                struct Entry {
+                    id: String,
+                    category: String,
+                }
+                let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
+                    format!(
+                        "{}: expected a suite manifest ({{\"objects\": [{{\"id\", \"category\"}}]}}): {e}",
+                        path.display()
+                    )
+                })?;
+                let capture = CaptureSettings {
+                    size: manifest.capture.width,
+                    train_views: manifest.capture.train_views,
+                };
+                let objects = manifest
+                    .objects
+                    .into_iter()
+                    .map(|o| {
+                        // Ids name folders inside the suite: nothing that could leave it.
+                        let plain = !o.id.is_empty()
+                            && o.id
+                                .chars()
+                                .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
+                        if !plain {
+                            return Err(format!(
+                                "{}: object id {:?} is not a plain folder name",
+                                path.display(),
+                                o.id
+                            ));
+                        }
+                        Ok(SourceObject {
+                            id: o.id,
+                            category: o.category,
+                            entry: None,
+                        })
+                    })
+                    .collect::<Result<_, _>>()?;
+                Ok((objects, capture))
+            }
+        }
+    }
+
+    /// One object's dataset.
+    fn load(
+        &self,
+        ctx: &GpuContext,
+        object: &SourceObject,
+    ) -> Result<crate::data::Dataset, String> {
+        match (self, &object.entry) {
+            (SuiteSource::Capture { size, views, .. }, Some(entry)) => {
+                capture_entry(ctx, entry, *size, *views, 2)
+            }
+            (SuiteSource::Dir(dir), _) => {
+                let folder = dir.join(&object.id);
+                let files = crate::data::read_dir(&folder)
+                    .map_err(|e| format!("{}: {e}", folder.display()))?;
+                crate::data::Dataset::from_files(&files)
+                    .map_err(|e| format!("{}: {} problem(s):\n{e}", folder.display(), e.0.len()))
+            }
+            _ => Err(format!("{}: no capture plan", object.id)),
+        }
+    }
+}
+
+/// Fits the suite's objects (all, or those whose id contains one of `only`) and scores them.
+/// With `ablations`, each object's reconstruction is also re-articulated without each
+/// consistency component, and reconstructed and articulated once more with global remeshing.
 pub fn fit(
     ctx: &GpuContext,
     config: &crate::fit::object::FitConfig,
-    quick: bool,
+    source: &SuiteSource,
     only: &[String],
-    size: u32,
-    views: usize,
     ablations: bool,
     log: &mut dyn FnMut(&FitObject),
 ) -> Result<FitBench, String> {
@@ -592,7 +709,6 @@ pub fn fit(
     use crate::fit::articulate::{Ablation, articulate};
     use crate::fit::object::ObjectFit;
     use crate::fit::reconstruct::{RemeshMode, reconstruct};
-    use crate::synth::suite_plan;
     let started = Instant::now();
     let options = EvalOptions::default();
     let mut objects = Vec::new();
@@ -604,15 +720,17 @@ pub fn fit(
             objects: Vec::new(),
         })
         .collect();
-    for entry in suite_plan(quick) {
-        let id = entry.id();
+    let (listed, capture) = source.objects()?;
+    for object in listed {
+        let id = object.id.clone();
         if !only.is_empty() && !only.iter().any(|o| id.contains(o.as_str())) {
             continue;
         }
         let named = |e: String| format!("{id}: {e}");
-        let dataset = capture_entry(ctx, &entry, size, views)?;
+        let dataset = source.load(ctx, &object)?;
+        let category = object.category.clone();
         let score = |fit: &ObjectFit| -> Result<crate::eval::ObjectMetrics, String> {
-            fit.evaluate(&dataset, &id, entry.category, &options)
+            fit.evaluate(&dataset, &id, &category, &options)
                 .ok_or_else(|| named("the captured object has no ground-truth joints".into()))?
                 .map_err(|e| named(e.to_string()))
         };
@@ -641,7 +759,7 @@ pub fn fit(
         let metrics = score(&fit)?;
         let done = FitObject {
             id: id.clone(),
-            category: entry.category,
+            category: object.category.clone(),
             parts: dataset.num_parts,
             seconds,
             reconstruct_s,
@@ -712,12 +830,9 @@ pub fn fit(
     Ok(FitBench {
         bench: "fit",
         adapter: ctx.adapter.clone(),
-        suite: if quick { "quick" } else { "full" },
+        suite: source.clone(),
         config: *config,
-        capture: CaptureSettings {
-            size,
-            train_views: views,
-        },
+        capture,
         by_part_count: BenchmarkTable::by_part_count(&metrics),
         by_category: BenchmarkTable::by_category(&metrics),
         ablation,
@@ -928,6 +1043,103 @@ pub fn spread(
         max_motion: max(&|s| s.motion),
         fits,
         shifts,
+        total_s: started.elapsed().as_secs_f64(),
+    })
+}
+
+/// One object of `artmesh bench joints`.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasuredObject {
+    pub id: String,
+    pub seconds: f64,
+    pub metrics: crate::eval::ObjectMetrics,
+    /// Per movable part, its measured joint (`None`: not in both states' clouds).
+    pub joints: Vec<Option<crate::articulation::geometric::GeometricJoint>>,
+}
+
+/// `artmesh bench joints` output.
+#[derive(Debug, Clone, Serialize)]
+pub struct MeasuredBench {
+    pub bench: &'static str,
+    pub suite: SuiteSource,
+    pub clouds: crate::articulation::observed::CloudOptions,
+    pub objects: Vec<MeasuredObject>,
+    pub by_part_count: crate::eval::BenchmarkTable,
+    pub total_s: f64,
+}
+
+/// The joints the suite's depth and part maps measure on their own (no reconstruction, no
+/// photometry), scored against ground truth: what the fit's geometric stage starts from.
+pub fn measured_joints(
+    ctx: &GpuContext,
+    source: &SuiteSource,
+    only: &[String],
+    clouds: &crate::articulation::observed::CloudOptions,
+    log: &mut dyn FnMut(&MeasuredObject),
+) -> Result<MeasuredBench, String> {
+    use crate::articulation::geometric::fit_joint;
+    use crate::articulation::observed::observe_dataset;
+    use crate::data::{JointKind, Split};
+    let started = Instant::now();
+    let (listed, _) = source.objects()?;
+    let mut objects = Vec::new();
+    for object in listed {
+        let id = object.id.clone();
+        if !only.is_empty() && !only.iter().any(|o| id.contains(o.as_str())) {
+            continue;
+        }
+        let dataset = source.load(ctx, &object)?;
+        let start = Instant::now();
+        let [s, e] = observe_dataset(&dataset, Split::Train, clouds)
+            .ok_or_else(|| format!("{id}: no training views of both states"))?;
+        let joints: Vec<_> = (1..dataset.num_parts)
+            .map(|p| {
+                let anchor = crate::eval::chamfer::KdTree::new(&s.others(p, 20_000));
+                fit_joint(&s.parts[p], &e.parts[p], Some(&anchor))
+            })
+            .collect();
+        let all: Vec<glam::Vec3> = s.parts.iter().flat_map(|c| c.points.clone()).collect();
+        let center = crate::articulation::init::principal_frame(&all)
+            .map_or(glam::DVec3::ZERO, |f| f.centroid);
+        let predicted: Vec<crate::data::GtJoint> = joints
+            .iter()
+            .map(|g| match g {
+                Some(g) => g.motion(g.kind).joint(g.kind, center),
+                None => {
+                    crate::articulation::PartMotion::IDENTITY.joint(JointKind::Revolute, center)
+                }
+            })
+            .collect();
+        let seconds = start.elapsed().as_secs_f64();
+        let gt = dataset
+            .gt_joints
+            .as_ref()
+            .ok_or_else(|| format!("{id}: no ground-truth joints"))?;
+        let metrics = crate::eval::evaluate_object(
+            &id,
+            &object.category,
+            &predicted,
+            gt,
+            None,
+            &crate::eval::EvalOptions::default(),
+        )
+        .map_err(|e| format!("{id}: {e}"))?;
+        let done = MeasuredObject {
+            id,
+            seconds,
+            metrics,
+            joints,
+        };
+        log(&done);
+        objects.push(done);
+    }
+    let metrics: Vec<_> = objects.iter().map(|o| o.metrics.clone()).collect();
+    Ok(MeasuredBench {
+        bench: "joints",
+        suite: source.clone(),
+        clouds: *clouds,
+        by_part_count: crate::eval::BenchmarkTable::by_part_count(&metrics),
+        objects,
         total_s: started.elapsed().as_secs_f64(),
     })
 }

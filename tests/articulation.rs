@@ -12,11 +12,20 @@ fn motion_kernels_match_the_cpu() {
 
 use artmesh::data::{JointKind, Split, State};
 use artmesh::eval::EvalOptions;
-use artmesh::fit::object::tiny_fit;
+use artmesh::fit::articulate::GeometryUse;
+use artmesh::fit::object::{FitConfig, tiny_fit, tiny_fit_with};
+use artmesh::fit::reconstruct::Preset;
 use artmesh::synth::Category;
 
 fn no_edit(_: &mut artmesh::data::Dataset) {}
 fn no_spec_edit(_: &mut artmesh::render::RenderSpec) {}
+
+/// The tiny preset without the measured joints: the paper's photometric stages alone.
+fn photometric_only() -> FitConfig {
+    let mut config = FitConfig::preset(Preset::Tiny);
+    config.articulation.geometry = GeometryUse::Off;
+    config
+}
 
 #[test]
 fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
@@ -25,8 +34,16 @@ fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
         (Category::Laptop, 1005, JointKind::Revolute),
         (Category::Pen, 1007, JointKind::Prismatic),
     ] {
-        let (dataset, fit) =
-            pollster::block_on(tiny_fit(&ctx, category, 1, seed, &no_spec_edit, &no_edit)).unwrap();
+        let (dataset, fit) = pollster::block_on(tiny_fit_with(
+            &ctx,
+            category,
+            1,
+            seed,
+            &no_spec_edit,
+            &no_edit,
+            &photometric_only(),
+        ))
+        .unwrap();
         let joint = &fit.articulation.joints[0];
         println!("{category:?}: {joint:#?}");
         assert_eq!(joint.kind, want, "{:?}", joint.bake_off);
@@ -129,4 +146,51 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
     .unwrap_err();
     println!("no depth: {err}");
     assert!(err.contains("depth") && err.contains("end"), "{err}");
+}
+
+/// The measured joints at CI size: the photometric fit at the tiny preset's 32², the depth and
+/// part maps captured at 200² (what a user's dataset holds beyond the working size).
+#[test]
+fn measured_joints_get_every_type_right_on_a_two_and_a_six_part_object() {
+    let ctx = common::context();
+    for (category, parts, seed, max_axis_deg) in [
+        (Category::Laptop, 1, 1005, 1.0),
+        (Category::StorageFurniture, 5, 1010, 2.0),
+    ] {
+        let (dataset, fit) = pollster::block_on(tiny_fit(
+            &ctx,
+            category,
+            parts,
+            seed,
+            &|spec| {
+                spec.width = 200;
+                spec.height = 200;
+                spec.train_views = 20;
+                spec.test_views = 4;
+            },
+            &no_edit,
+        ))
+        .unwrap();
+        let metrics = fit
+            .evaluate(
+                &dataset,
+                "measured",
+                category.name(),
+                &EvalOptions::default(),
+            )
+            .unwrap()
+            .unwrap();
+        println!("{category:?}: {}", serde_json::to_string(&metrics).unwrap());
+        for j in &fit.articulation.joints {
+            println!(
+                "part {}: {:?} by {} flag {:?}",
+                j.part, j.kind, j.decided_by, j.flag
+            );
+            assert!(j.geometry.is_some(), "part {} was not measured", j.part);
+        }
+        assert_eq!(metrics.type_accuracy, Some(1.0), "{metrics:?}");
+        for pair in &metrics.joints {
+            assert!(pair.axis_ang < max_axis_deg, "{pair:?}");
+        }
+    }
 }

@@ -119,6 +119,8 @@ const LEAF_SIZE: usize = 8;
 pub struct KdTree {
     points: Vec<Vec3>,
     axis: Vec<u8>,
+    /// Each stored point's index in the input (the build reorders them).
+    input: Vec<u32>,
 }
 
 impl KdTree {
@@ -127,6 +129,7 @@ impl KdTree {
         let mut tree = KdTree {
             points: points.to_vec(),
             axis: vec![0; points.len()],
+            input: (0..points.len() as u32).collect(),
         };
         tree.build(0, points.len());
         tree
@@ -151,7 +154,17 @@ impl KdTree {
             2
         };
         let m = lo + (hi - lo) / 2;
-        self.points[lo..hi].select_nth_unstable_by(m - lo, |a, b| a[axis].total_cmp(&b[axis]));
+        // Points and their input indices move together.
+        let mut order: Vec<(Vec3, u32)> = self.points[lo..hi]
+            .iter()
+            .copied()
+            .zip(self.input[lo..hi].iter().copied())
+            .collect();
+        order.select_nth_unstable_by(m - lo, |a, b| a.0[axis].total_cmp(&b.0[axis]));
+        for (i, (p, k)) in order.into_iter().enumerate() {
+            self.points[lo + i] = p;
+            self.input[lo + i] = k;
+        }
         self.axis[m] = axis as u8;
         self.build(lo, m);
         self.build(m + 1, hi);
@@ -177,6 +190,14 @@ impl KdTree {
         let mut best = (f64::INFINITY, usize::MAX);
         self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
         self.points.get(best.1).map(|&p| (p, best.0))
+    }
+
+    /// The input index of the point nearest to `q` and its squared distance; `None` for an
+    /// empty tree.
+    pub fn nearest_index(&self, q: Vec3) -> Option<(usize, f64)> {
+        let mut best = (f64::INFINITY, usize::MAX);
+        self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
+        self.input.get(best.1).map(|&i| (i as usize, best.0))
     }
 
     fn search(&self, q: glam::DVec3, lo: usize, hi: usize, best: &mut (f64, usize)) {

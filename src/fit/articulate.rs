@@ -31,11 +31,13 @@ use super::photometric::encode_loss_and_backward;
 use super::reconstruct::{Phase, Preset, Progress, Reconstruction, training_views};
 use super::views::ViewCycle;
 use crate::articulation::axis_registration::{AxisRegistration, register_along_axis};
+use crate::articulation::geometric::{CloudPair, GeometricJoint, SMALL_MARGIN, fit_joint};
 use crate::articulation::init::{JointCandidates, initial_candidates, principal_frame};
 use crate::articulation::kernels::{MotionKernels, MovedMesh};
+use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
 use crate::articulation::vertex_motion::{StateSurface, VertexMotionWeights, vertex_motion_loss};
 use crate::articulation::{MotionAdam, MotionMask, MotionRates, PartMotion, PartSums};
-use crate::data::{Dataset, Frame, GtJoint, JointKind, State};
+use crate::data::{Dataset, Frame, GtJoint, JointKind, Split, State};
 use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
 use crate::loss::{ImageLoss, LossWeights, SSIM_C1, SSIM_C2, TargetImages, TargetView, ssim_taps};
 use crate::raster::{GpuField, MeshField, RasterSettings, RasterState, Rasterizer};
@@ -98,6 +100,37 @@ pub enum RefineViews {
     All,
 }
 
+/// How the articulation uses the part surfaces measured by the dataset's full-resolution depth
+/// and part maps ([`crate::articulation::geometric`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GeometryUse {
+    /// Not at all: the paper's method (seeds from the reconstructed meshes, photometric stages).
+    Off,
+    /// Measured joints seed the photometric stages of every part, the measured type evidence
+    /// overrules a bake-off it contradicts by a clear margin, and the result is kept only where it
+    /// fits the measured surfaces at least as well as its seed.
+    Seed,
+    /// As `Seed`, but a joint the measurements settle (motion visible, type by a clear margin)
+    /// is taken as measured: the photometric stages run only for the parts they cannot settle
+    /// (no depth, unobservable motion, a close type call), and not at all when none is left.
+    Settle,
+}
+
+impl GeometryUse {
+    /// The mode named as on the command line (`off`, `seed`, `settle`).
+    pub fn parse(name: &str) -> Result<GeometryUse, String> {
+        match name {
+            "off" => Ok(GeometryUse::Off),
+            "seed" => Ok(GeometryUse::Seed),
+            "settle" => Ok(GeometryUse::Settle),
+            other => Err(format!(
+                "unknown geometry mode {other:?}: expected off, seed or settle"
+            )),
+        }
+    }
+}
+
 /// Schedule, weights and learning rates of the articulation phase.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ArticulationConfig {
@@ -132,6 +165,13 @@ pub struct ArticulationConfig {
     /// ([`register_along_axis`]). On the fast laptop it took the motion 0.51° → 0.15° from the
     /// truth and the browser-vs-native gap 0.84° → 0.28° (README "Browser app").
     pub register_magnitude: bool,
+    /// How the measured part surfaces are used.
+    pub geometry: GeometryUse,
+    /// How those surfaces are sampled.
+    pub clouds: CloudOptions,
+    /// A stage stops early once its reported loss changes by less than this fraction between
+    /// two reports (0: never).
+    pub flat_tolerance: f64,
     pub ablation: Ablation,
     /// Loss terms are read back (and reported) every this many steps.
     pub report_every: u32,
@@ -189,6 +229,12 @@ impl ArticulationConfig {
             refine_views,
             final_rate: 0.05,
             register_magnitude,
+            geometry: match preset {
+                Preset::Tiny | Preset::Fast => GeometryUse::Settle,
+                Preset::Paper => GeometryUse::Off,
+            },
+            clouds: CloudOptions::default(),
+            flat_tolerance: 1e-3,
             ablation: Ablation::FULL,
             report_every,
             seed: 7,
@@ -223,6 +269,14 @@ pub struct FittedJoint {
     pub bake_off: BakeOff,
     /// What the axis registration changed (`None`: off, or nothing to register).
     pub axis_registration: Option<AxisRegistration>,
+    /// The joint measured from the full-resolution depth and part maps (`None`: off, or the
+    /// part was not measured in both states).
+    pub geometry: Option<GeometricJoint>,
+    /// What decided the type and the motion: `geometry`, `bake-off`, `geometry+refined`, …
+    pub decided_by: &'static str,
+    /// Why this joint should be checked by hand (a close type call, a part too small or
+    /// unobservable in the data); `None` when nothing is known to be wrong.
+    pub flag: Option<String>,
 }
 
 /// One reported point of the articulation curve.
@@ -598,6 +652,85 @@ fn backward_maps(motions: &[PartMotion]) -> Vec<(DMat3, DVec3)> {
 const STILL_ANGLE_DEG: f64 = 0.5;
 const STILL_DISTANCE_M: f64 = 0.002;
 
+/// The joints the dataset's depth and part maps measure: per movable part the geometric fit
+/// on the training views' clouds, and the pairs of the test views' clouds (the training ones
+/// when there are no test views) that judge a refined joint against its seed.
+struct Measured<'a> {
+    joints: Vec<Option<GeometricJoint>>,
+    judges: Vec<Option<CloudPair<'a>>>,
+}
+
+/// Points of the rest of the object a measured joint's axis is checked against.
+const ANCHOR_POINTS: usize = 20_000;
+
+/// Both states' clouds of a split, or `None` (no views of it, or the geometry is off).
+fn observe(
+    dataset: &Dataset,
+    config: &ArticulationConfig,
+    split: Split,
+) -> Option<[ObservedState; 2]> {
+    (config.geometry != GeometryUse::Off)
+        .then(|| observe_dataset(dataset, split, &config.clouds))
+        .flatten()
+}
+
+impl<'a> Measured<'a> {
+    fn new(
+        k: usize,
+        train: Option<&'a [ObservedState; 2]>,
+        test: Option<&'a [ObservedState; 2]>,
+    ) -> Self {
+        let usable = |c: &crate::articulation::observed::PartCloud| c.points.len() >= 3;
+        let joints = (0..k)
+            .map(|part| {
+                let [s, e] = train?;
+                let anchor = crate::eval::chamfer::KdTree::new(&s.others(part, ANCHOR_POINTS));
+                (part > 0)
+                    .then(|| fit_joint(&s.parts[part], &e.parts[part], Some(&anchor)))
+                    .flatten()
+            })
+            .collect();
+        let judges = (0..k)
+            .map(|part| {
+                let [s, e] = test.or(train)?;
+                let (a, b) = (&s.parts[part], &e.parts[part]);
+                (part > 0 && usable(a) && usable(b)).then(|| CloudPair::new(a, b))
+            })
+            .collect();
+        Self { joints, judges }
+    }
+}
+
+/// Why a measured (or unmeasured) joint should be checked by hand.
+fn flag(geometry: Option<&GeometricJoint>, measured: bool) -> Option<String> {
+    use crate::articulation::geometric::MIN_POINTS;
+    let Some(g) = geometry else {
+        return measured.then(|| {
+            "not measured in the depth and part maps (no view shows it with depth in both states): fitted from photometry alone".to_string()
+        });
+    };
+    if g.points.iter().any(|&n| n < MIN_POINTS) {
+        Some(format!(
+            "too small in the depth and part maps ({} / {} points in the two states): its joint is unreliable",
+            g.points[0], g.points[1]
+        ))
+    } else if !g.observable {
+        Some(format!(
+            "its motion is not visible in the depth maps (not moving fits within {:.1} mm of either joint: a part symmetric about its axis?): type and motion come from photometry",
+            1000.0 * (g.identity_residual - g.revolute_residual.min(g.prismatic_residual))
+        ))
+    } else if g.margin < SMALL_MARGIN {
+        Some(format!(
+            "joint type decided by a small margin {:.2} (revolute residual {:.2} mm, prismatic {:.2} mm)",
+            g.margin,
+            1000.0 * g.revolute_residual,
+            1000.0 * g.prismatic_residual
+        ))
+    } else {
+        None
+    }
+}
+
 /// Runs the articulation phase on a reconstruction of `dataset` (its two states' frozen meshes
 /// and training views).
 pub async fn articulate(
@@ -668,11 +801,30 @@ pub async fn articulate(
     };
     let mut revolute = pick(|c| c.revolute);
     let mut prismatic = pick(|c| c.prismatic);
-    let trainable: Vec<bool> = candidates.iter().map(Option::is_some).collect();
+    // The measured joints: seeds where there are, and the settled parts out of the photometry.
+    let train_clouds = observe(dataset, config, Split::Train);
+    let test_clouds = observe(dataset, config, Split::Test);
+    let measured = Measured::new(k, train_clouds.as_ref(), test_clouds.as_ref());
+    let settled: Vec<bool> = measured
+        .joints
+        .iter()
+        .map(|g| config.geometry == GeometryUse::Settle && g.is_some_and(|g| g.settled()))
+        .collect();
+    for part in 1..k {
+        if let Some(g) = &measured.joints[part] {
+            revolute[part] = g.revolute;
+            prismatic[part] = g.prismatic;
+        }
+    }
+    let trainable: Vec<bool> = (0..k)
+        .map(|p| candidates[p].is_some() && !settled[p])
+        .collect();
     times.setup_s = now_seconds() - t0;
 
-    let n = config.iterations;
-    let decide = config.decision_step();
+    // No part left for photometry: no photometric step at all.
+    let photometric = trainable.iter().any(|&t| t);
+    let n = if photometric { config.iterations } else { 0 };
+    let decide = config.decision_step().min(n);
     let backward_from = (n as f32 * config.backward_from) as u32;
     let mut rng = Rng::new(config.seed);
     let mut curve = Vec::new();
@@ -744,16 +896,18 @@ pub async fn articulate(
     // 2. Bake-off.
     let t_bake = now_seconds();
     checkpoint(observer, &event(Phase::BakeOff, 0, (k - 1) as u32, None)).await?;
-    let mut kinds = vec![JointKind::Revolute; k];
-    let mut bake_offs = vec![
-        BakeOff {
+    let mut kinds: Vec<JointKind> = (0..k)
+        .map(|p| measured.joints[p].map_or(JointKind::Revolute, |g| g.kind))
+        .collect();
+    let mut bake_offs: Vec<BakeOff> = kinds
+        .iter()
+        .map(|&kind| BakeOff {
             revolute_loss: None,
             prismatic_loss: None,
             pixels: 0,
-            kind: JointKind::Revolute
-        };
-        k
-    ];
+            kind,
+        })
+        .collect();
     for part in (1..k).filter(|&p| trainable[p]) {
         let only = |m: PartMotion| -> Vec<(DMat3, DVec3)> {
             (0..k)
@@ -785,6 +939,11 @@ pub async fn articulate(
                 JointKind::Prismatic
             }
         };
+        // A clear measured type overrules the bake-off (Seed mode; Settle never gets here then).
+        let kind = match &measured.joints[part] {
+            Some(g) if g.observable && g.margin >= SMALL_MARGIN => g.kind,
+            _ => kind,
+        };
         kinds[part] = kind;
         bake_offs[part] = BakeOff {
             revolute_loss: (pixels > 0).then(|| rot / pixels as f64),
@@ -800,7 +959,7 @@ pub async fn articulate(
     }
     let mut motions: Vec<PartMotion> = (0..k)
         .map(|p| match kinds[p] {
-            _ if !trainable[p] => PartMotion::IDENTITY,
+            _ if !trainable[p] && !settled[p] => PartMotion::IDENTITY,
             JointKind::Revolute => revolute[p],
             JointKind::Prismatic => prismatic[p],
         })
@@ -893,22 +1052,52 @@ pub async fn articulate(
 
     let joints: Vec<FittedJoint> = (1..k)
         .map(|part| {
-            let (motion, axis_registration) = if config.register_magnitude && trainable[part] {
-                register_along_axis(motions[part], kinds[part], &surface1, &surface2, part)
+            let geometry = measured.joints[part];
+            let kind = kinds[part];
+            let (mut motion, mut axis_registration) =
+                if config.register_magnitude && trainable[part] {
+                    register_along_axis(motions[part], kind, &surface1, &surface2, part)
+                } else {
+                    (motions[part], None)
+                };
+            let mut decided_by = if settled[part] {
+                "geometry"
+            } else if trainable[part] {
+                "bake-off+refined"
             } else {
-                (motions[part], None)
+                "none"
             };
+            // Never worse than the measured seed on the held-out measurements.
+            if let (Some(g), Some(judge), true) =
+                (geometry, &measured.judges[part], trainable[part])
+            {
+                let seed = g.motion(kind);
+                if judge.residual(&seed) < judge.residual(&motion) {
+                    motion = seed;
+                    axis_registration = None;
+                    decided_by = "geometry (kept over the refinement)";
+                }
+            }
+            let flag = flag(geometry.as_ref(), config.geometry != GeometryUse::Off);
             FittedJoint {
                 part,
-                kind: kinds[part],
+                kind,
                 motion,
-                joint: motion.joint(kinds[part], center),
+                joint: motion.joint(kind, center),
                 initial: candidates[part],
                 bake_off: bake_offs[part],
                 axis_registration,
+                geometry,
+                decided_by,
+                flag,
             }
         })
         .collect();
+    for j in &joints {
+        if let Some(f) = &j.flag {
+            warnings.push(format!("part {}: {f}", j.part));
+        }
+    }
     for j in &joints {
         let tiny = match j.kind {
             JointKind::Revolute => f64::from(j.joint.motion().abs()) < STILL_ANGLE_DEG,
@@ -918,7 +1107,9 @@ pub async fn articulate(
             .initial
             .as_ref()
             .is_some_and(JointCandidates::barely_moves);
-        if (tiny && j.initial.is_some()) || unresolved {
+        // The measurements saw it move: the reconstructions' view does not count.
+        let seen_moving = j.geometry.is_some_and(|g| g.observable);
+        if ((tiny && j.initial.is_some()) || unresolved) && !seen_moving {
             warnings.push(format!(
                 "part {} barely moves between the states (fitted {:.3} {}; not moving at all fits its two reconstructions about as well): its axis and joint type are guesses",
                 j.part,

@@ -115,8 +115,31 @@ pub struct JointRecord {
     /// The magnitude before and after its registration along the axis (absent when off).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub axis_registration: Option<crate::articulation::axis_registration::AxisRegistration>,
+    /// What decided the type and motion (`geometry`, `bake-off+refined`, …).
+    pub decided_by: &'static str,
+    /// The joint measured from the full-resolution depth and part maps: residuals (mm) of
+    /// both models and of not moving, and the type call's margin (flagged under 0.5).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub geometry: Option<GeometryRecord>,
+    /// Why the joint should be checked by hand; absent when nothing is known to be wrong.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub flag: Option<String>,
     /// The fitted start → end motion g⁺ of the part as a 4 × 4 matrix, rows first (world frame).
     pub end_transform: [[f64; 4]; 4],
+}
+
+/// The measured evidence behind a joint, as `joints.json` lists it.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct GeometryRecord {
+    #[serde(rename = "type")]
+    pub kind: JointKind,
+    pub margin: f64,
+    pub revolute_residual_mm: f64,
+    pub prismatic_residual_mm: f64,
+    pub identity_residual_mm: f64,
+    pub observable: bool,
+    /// Points of the part in the start and end clouds.
+    pub points: [usize; 2],
 }
 
 impl ObjectFit {
@@ -147,6 +170,17 @@ impl ObjectFit {
                     limits: [motion.min(0.0), motion.max(0.0)],
                     bake_off: [j.bake_off.revolute_loss, j.bake_off.prismatic_loss],
                     axis_registration: j.axis_registration,
+                    decided_by: j.decided_by,
+                    geometry: j.geometry.map(|g| GeometryRecord {
+                        kind: g.kind,
+                        margin: g.margin,
+                        revolute_residual_mm: 1000.0 * g.revolute_residual,
+                        prismatic_residual_mm: 1000.0 * g.prismatic_residual,
+                        identity_residual_mm: 1000.0 * g.identity_residual,
+                        observable: g.observable,
+                        points: g.points,
+                    }),
+                    flag: j.flag.clone(),
                     end_transform: [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]],
                 }
             })
@@ -213,17 +247,30 @@ pub async fn tiny_fit(
     spec_edit: &dyn Fn(&mut crate::render::RenderSpec),
     edit: &dyn Fn(&mut Dataset),
 ) -> Result<(Dataset, ObjectFit), String> {
+    let config = FitConfig::preset(Preset::Tiny);
+    tiny_fit_with(ctx, category, movable_parts, seed, spec_edit, edit, &config).await
+}
+
+/// [`tiny_fit`] with another fit configuration (the capture stays the tiny preset's).
+pub async fn tiny_fit_with(
+    ctx: &GpuContext,
+    category: crate::synth::Category,
+    movable_parts: usize,
+    seed: u64,
+    spec_edit: &dyn Fn(&mut crate::render::RenderSpec),
+    edit: &dyn Fn(&mut Dataset),
+    config: &FitConfig,
+) -> Result<(Dataset, ObjectFit), String> {
     let object = crate::synth::generate(&crate::synth::SynthParams {
         category,
         movable_parts: Some(movable_parts),
         seed,
     })?;
-    let config = FitConfig::preset(Preset::Tiny);
-    let mut spec = config.demo_capture(seed);
+    let mut spec = FitConfig::preset(Preset::Tiny).demo_capture(seed);
     spec_edit(&mut spec);
     let mut dataset = crate::render::capture_dataset(ctx, &object, &spec, &mut |_| {}).await?;
     edit(&mut dataset);
-    let fit = fit_object(ctx, &dataset, &config, &mut Unobserved)
+    let fit = fit_object(ctx, &dataset, config, &mut Unobserved)
         .await
         .map_err(|e| e.to_string())?;
     Ok((dataset, fit))

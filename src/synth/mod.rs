@@ -15,7 +15,7 @@ mod categories;
 mod suite;
 pub mod texture;
 
-pub use suite::{FULL_BUCKETS, SuiteEntry, suite_plan};
+pub use suite::{FULL_BUCKETS, SuiteEntry, SuiteKind, suite_plan};
 
 use std::ops::RangeInclusive;
 

@@ -10,7 +10,7 @@ use artmesh::object::ArticulatedObject;
 use artmesh::render::{
     RenderProgress, RenderSpec, RenderedDataset, SheetEntry, contact_sheet, render_dataset,
 };
-use artmesh::synth::{SuiteEntry, generate, suite_plan};
+use artmesh::synth::{SuiteEntry, SuiteKind, generate};
 
 use super::CaptureArgs;
 
@@ -144,11 +144,12 @@ struct ManifestEntry<'a> {
 pub fn suite(
     ctx: &GpuContext,
     out: &Path,
-    quick: bool,
+    kind: SuiteKind,
     capture: &CaptureArgs,
 ) -> Result<(), String> {
     fresh_folder(out)?;
-    let plan = suite_plan(quick);
+    let quick = kind == SuiteKind::Quick;
+    let plan = kind.plan();
     let mut objects = Vec::with_capacity(plan.len());
     let mut manifest = Vec::with_capacity(plan.len());
     let spec0 = capture.spec(quick, 0);
@@ -159,7 +160,7 @@ pub fn suite(
         let rendered = dataset(ctx, &object, &capture.spec(quick, entry.seed), &folder)?;
         eprintln!(
             "[{}/{}] {} ({} parts, {} frames)",
-            entry.index + 1,
+            manifest.len() + 1,
             plan.len(),
             entry.id(),
             rendered.num_parts,
@@ -174,7 +175,7 @@ pub fn suite(
         objects.push((object, rendered.truth.states));
     }
     let json = SuiteManifest {
-        suite: if quick { "quick" } else { "full" },
+        suite: kind.name(),
         generator: format!("artmesh {}", env!("CARGO_PKG_VERSION")),
         capture: CaptureJson {
             width: spec0.width,
