@@ -719,7 +719,14 @@ mod cli {
                     seed,
                 })?;
                 let config = fit_config(&preset)?;
-                let spec = config.demo_capture(seed);
+                // Captured as a user's dataset would be: the fit reads its working size, and
+                // its joints come from the full-resolution depth and part maps (at 64² those
+                // are too coarse: the demo cabinet's axes came out 20.9° off) and are judged
+                // on the test views.
+                let mut spec = config.demo_capture(seed);
+                spec.width = (4 * spec.width).min(512);
+                spec.height = spec.width;
+                spec.test_views = 4;
                 let (size, views) = (spec.width, spec.train_views);
                 let ctx = context()?;
                 eprintln!(

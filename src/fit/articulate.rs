@@ -315,6 +315,9 @@ pub struct Articulation {
     /// Things a user should know (a part unseen in one state, one that does not move).
     pub warnings: Vec<String>,
     pub times: ArticulationTimes,
+    /// The refinement step at which its objective was flat and it stopped (`None`: it ran its
+    /// steps, or did not run).
+    pub refine_stopped_at: Option<u32>,
 }
 
 impl Articulation {
@@ -985,6 +988,7 @@ pub async fn articulate(
     let vertex_on = vertex.color > 0.0 || vertex.opacity > 0.0;
     let refine = n - decide;
     checkpoint(observer, &event(Phase::Refine, 0, refine, None)).await?;
+    let (mut last_objective, mut refine_stopped_at) = (None::<f64>, None);
     for i in decide..n {
         adam.set_scale(
             config
@@ -1046,6 +1050,18 @@ pub async fn articulate(
                 &event(Phase::Refine, step + 1, refine, Some(forward_loss)),
             )
             .await?;
+            // Flat: the reported objective moved by less than the tolerance since the last report.
+            let objective = f64::from(forward_loss)
+                + f64::from(backward_loss.unwrap_or(0.0))
+                + vertex_loss.unwrap_or(0.0);
+            if let Some(before) = last_objective {
+                let change: f64 = (objective - before) / f64::max(f64::abs(before), 1e-12);
+                if change.abs() < config.flat_tolerance && i + 1 < n {
+                    refine_stopped_at = Some(step + 1);
+                    break;
+                }
+            }
+            last_objective = Some(objective);
         }
     }
     times.refine_s = now_seconds() - t_refine;
@@ -1127,5 +1143,6 @@ pub async fn articulate(
         curve,
         warnings,
         times,
+        refine_stopped_at,
     })
 }
