@@ -1094,7 +1094,10 @@ pub fn measured_joints(
             .ok_or_else(|| format!("{id}: no training views of both states"))?;
         let joints: Vec<_> = (1..dataset.num_parts)
             .map(|p| {
-                let anchor = crate::eval::chamfer::KdTree::new(&s.others(p, 20_000));
+                let anchor = crate::articulation::geometric::Anchor::new(
+                    &s.others(p, 20_000),
+                    &e.others(p, 20_000),
+                );
                 fit_joint(&s.parts[p], &e.parts[p], Some(&anchor))
             })
             .collect();

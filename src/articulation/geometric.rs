@@ -16,7 +16,7 @@
 //! A part whose not moving fits about as well as either model (a knob symmetric about its own
 //! axis) is not observable here: its type is left to the photometric bake-off.
 
-use glam::{DQuat, DVec3};
+use glam::{DQuat, DVec3, Vec3};
 use serde::Serialize;
 
 use super::init::{JointCandidates, initial_candidates};
@@ -349,9 +349,30 @@ fn revolute_starts(start: &PartCloud) -> Vec<PartMotion> {
         .collect()
 }
 
-/// How far (m) the axis of `m`, over the stretch of it beside the part, passes from the rest
-/// of the object (`anchor`, the other parts in the start state). A hinge joins its part to the
-/// rest: the true axis runs along where they meet.
+/// The rest of the object in both states, which a part's hinge joins it to.
+pub struct Anchor {
+    start: KdTree,
+    end: KdTree,
+}
+
+impl Anchor {
+    /// Search trees over the other parts' points in the start and end states.
+    pub fn new(start: &[Vec3], end: &[Vec3]) -> Self {
+        Self {
+            start: KdTree::new(start),
+            end: KdTree::new(end),
+        }
+    }
+
+    /// How far (m) the axis of `m` passes from the rest of the object, the larger of the two
+    /// states' gaps: a hinge stays where its part meets the rest in both, while a false axis
+    /// near another moving part (a drawer pulled out in front of a door) is near it in one.
+    fn gap(&self, m: &PartMotion, pair: &CloudPair) -> f64 {
+        axis_gap(m, pair.start, &self.start).max(axis_gap(m, pair.end, &self.end))
+    }
+}
+
+/// How far (m) the axis of `m`, over the stretch of it beside the part, passes from `anchor`.
 fn axis_gap(m: &PartMotion, part: &PartCloud, anchor: &KdTree) -> f64 {
     let (axis, _) = rotation_axis_angle(m.rotation);
     let along: Vec<f64> = part
@@ -390,13 +411,13 @@ const SAME_COLOR: f64 = 0.005;
 fn most_plausible(
     fits: &[(f64, PartMotion)],
     pair: &CloudPair,
-    anchor: Option<&KdTree>,
+    anchor: Option<&Anchor>,
 ) -> Option<PartMotion> {
     let best = fits.iter().map(|t| t.0).fold(f64::INFINITY, f64::min);
     let good: Vec<(f64, PartMotion)> = fits
         .iter()
         .filter(|t| t.0 <= SAME_FIT * best + 1e-4)
-        .map(|t| (anchor.map_or(0.0, |a| axis_gap(&t.1, pair.start, a)), t.1))
+        .map(|t| (anchor.map_or(0.0, |a| a.gap(&t.1, pair)), t.1))
         .collect();
     let nearest = good.iter().map(|g| g.0).fold(f64::INFINITY, f64::min);
     let hinged: Vec<(f64, PartMotion)> = good
@@ -417,12 +438,12 @@ fn most_plausible(
 }
 
 /// Distinct starts refined fully after the coarse search.
-const FINALISTS: usize = 6;
+const FINALISTS: usize = 12;
 
 /// The best revolute motion: the registration seed and every turn of [`revolute_starts`]
 /// refined briefly on thinned clouds; the best few distinct ones (within twice the best
 /// residual) refined fully, then [`most_plausible`] of those.
-fn best_revolute(pair: &CloudPair, seed: PartMotion, anchor: Option<&KdTree>) -> PartMotion {
+fn best_revolute(pair: &CloudPair, seed: PartMotion, anchor: Option<&Anchor>) -> PartMotion {
     let step = pair.start.points.len().max(pair.end.points.len()) / SEARCH_POINTS + 1;
     let (a, b) = (thinned(pair.start, step), thinned(pair.end, step));
     let coarse = CloudPair::new(&a, &b);
@@ -483,7 +504,7 @@ fn best_prismatic(pair: &CloudPair, seed: PartMotion, revolute: &PartMotion) -> 
 pub fn fit_joint(
     start: &PartCloud,
     end: &PartCloud,
-    anchor: Option<&KdTree>,
+    anchor: Option<&Anchor>,
 ) -> Option<GeometricJoint> {
     let seeds: JointCandidates = initial_candidates(&start.points, &end.points)?;
     let pair = CloudPair::new(start, end);
@@ -537,7 +558,6 @@ pub fn moved_cloud(cloud: &PartCloud, m: &PartMotion) -> PartCloud {
 mod tests {
     use super::*;
     use crate::rng::Rng;
-    use glam::Vec3;
 
     /// A closed box surface (w × h × d m at `origin`) sampled with outward normals.
     fn box_cloud(rng: &mut Rng, size: DVec3, origin: DVec3, count: usize) -> PartCloud {

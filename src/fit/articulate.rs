@@ -31,7 +31,7 @@ use super::photometric::encode_loss_and_backward;
 use super::reconstruct::{Phase, Preset, Progress, Reconstruction, training_views};
 use super::views::ViewCycle;
 use crate::articulation::axis_registration::{AxisRegistration, register_along_axis};
-use crate::articulation::geometric::{CloudPair, GeometricJoint, SMALL_MARGIN, fit_joint};
+use crate::articulation::geometric::{Anchor, CloudPair, GeometricJoint, SMALL_MARGIN, fit_joint};
 use crate::articulation::init::{JointCandidates, initial_candidates, principal_frame};
 use crate::articulation::kernels::{MotionKernels, MovedMesh};
 use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
@@ -687,7 +687,10 @@ impl<'a> Measured<'a> {
         let joints = (0..k)
             .map(|part| {
                 let [s, e] = train?;
-                let anchor = crate::eval::chamfer::KdTree::new(&s.others(part, ANCHOR_POINTS));
+                let anchor = Anchor::new(
+                    &s.others(part, ANCHOR_POINTS),
+                    &e.others(part, ANCHOR_POINTS),
+                );
                 (part > 0)
                     .then(|| fit_joint(&s.parts[part], &e.parts[part], Some(&anchor)))
                     .flatten()
@@ -701,6 +704,31 @@ impl<'a> Measured<'a> {
             })
             .collect();
         Self { joints, judges }
+    }
+}
+
+/// Weight of the bake-off's evidence against the measured one. Its losses (summed over a
+/// part's pixels at the working size) differ by a fraction of a percent where the measured
+/// residuals differ by tens of percent; at this weight a bake-off 5 % apart outvotes a measured
+/// call on the threshold, and a tie leaves the measurements to decide.
+const BAKE_OFF_WEIGHT: f64 = 10.0;
+
+/// The joint type from both models' evidence: ln(prismatic / (slack × revolute)) of the measured
+/// residuals (none when the motion is not observable there) plus [`BAKE_OFF_WEIGHT`] times
+/// ln(prismatic / revolute) of the bake-off's losses; positive (or zero) is revolute, as the
+/// paper breaks ties.
+fn combined_kind(g: &GeometricJoint, revolute_loss: f64, prismatic_loss: f64) -> JointKind {
+    use crate::articulation::geometric::PRISMATIC_SLACK;
+    let measured = if g.observable {
+        (g.prismatic_residual / (PRISMATIC_SLACK * g.revolute_residual.max(1e-9))).ln()
+    } else {
+        0.0
+    };
+    let photometric = (prismatic_loss.max(1e-12) / revolute_loss.max(1e-12)).ln();
+    if measured + BAKE_OFF_WEIGHT * photometric >= 0.0 {
+        JointKind::Revolute
+    } else {
+        JointKind::Prismatic
     }
 }
 
@@ -942,9 +970,10 @@ pub async fn articulate(
                 JointKind::Prismatic
             }
         };
-        // A clear measured type overrules the bake-off (Seed mode; Settle never gets here then).
+        // Both models' evidence: the measured residuals' and the bake-off's log ratios.
         let kind = match &measured.joints[part] {
-            Some(g) if g.observable && g.margin >= SMALL_MARGIN => g.kind,
+            Some(g) if pixels > 0 => combined_kind(g, rot, trans),
+            Some(g) if g.observable => g.kind,
             _ => kind,
         };
         kinds[part] = kind;
