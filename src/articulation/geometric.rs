@@ -322,6 +322,7 @@ fn thinned(cloud: &PartCloud, step: usize) -> PartCloud {
         normals: cloud.normals.iter().step_by(step).copied().collect(),
         colors: cloud.colors.iter().step_by(step).copied().collect(),
         pixels: cloud.pixels,
+        labelled: cloud.labelled,
     }
 }
 
@@ -551,6 +552,7 @@ pub fn moved_cloud(cloud: &PartCloud, m: &PartMotion) -> PartCloud {
             .collect(),
         colors: cloud.colors.clone(),
         pixels: cloud.pixels,
+        labelled: cloud.labelled,
     }
 }
 

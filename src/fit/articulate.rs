@@ -707,6 +707,43 @@ impl<'a> Measured<'a> {
     }
 }
 
+/// What a user should know about the measurements: views without depth or part maps, no test
+/// views to judge by. A movable part that no training view of either state shows (not one
+/// pixel labelled with it) is an error: there is nothing to fit it to.
+fn measurement_warnings(
+    clouds: &[ObservedState; 2],
+    has_test_views: bool,
+    warnings: &mut Vec<String>,
+) -> GpuResult<()> {
+    for (state, c) in [State::Start, State::End].iter().zip(clouds) {
+        if c.views_with_depth < c.views {
+            warnings.push(format!(
+                "{} of the {} {} training views have no depth or part map of the colour image's size: the joints are measured from the other {}",
+                c.views - c.views_with_depth,
+                c.views,
+                state.name(),
+                c.views_with_depth
+            ));
+        }
+    }
+    let unseen: Vec<String> = (1..clouds[0].parts.len())
+        .filter(|&p| clouds.iter().all(|c| c.parts[p].labelled == 0))
+        .map(|p| p.to_string())
+        .collect();
+    if !unseen.is_empty() && clouds.iter().all(|c| c.views_with_depth > 0) {
+        return Err(GpuError::InvalidInput(format!(
+            "movable part(s) {} appear in no training view's part map (with depth) in either state: nothing to fit their joints to; check the semantic maps' ids (0 = background, k + 1 = part k)",
+            unseen.join(", ")
+        )));
+    }
+    if !has_test_views {
+        warnings.push(
+            "the dataset has no test views: refined joints are judged against their measured seeds on the training views' points".into(),
+        );
+    }
+    Ok(())
+}
+
 /// Weight of the bake-off's evidence against the measured one. Its losses (summed over a
 /// part's pixels at the working size) differ by a fraction of a percent where the measured
 /// residuals differ by tens of percent; at this weight a bake-off 5 % apart outvotes a measured
@@ -835,6 +872,9 @@ pub async fn articulate(
     // The measured joints: seeds where there are, and the settled parts out of the photometry.
     let train_clouds = observe(dataset, config, Split::Train);
     let test_clouds = observe(dataset, config, Split::Test);
+    if let Some(clouds) = &train_clouds {
+        measurement_warnings(clouds, test_clouds.is_some(), &mut warnings)?;
+    }
     let measured = Measured::new(k, train_clouds.as_ref(), test_clouds.as_ref());
     let settled: Vec<bool> = measured
         .joints
