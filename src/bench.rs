@@ -541,6 +541,7 @@ pub struct FitBench {
     pub bench: &'static str,
     pub adapter: AdapterReport,
     pub suite: SuiteSource,
+    pub depth_degradation: DepthDegradation,
     pub config: crate::fit::object::FitConfig,
     pub capture: CaptureSettings,
     pub objects: Vec<FitObject>,
@@ -694,6 +695,43 @@ impl SuiteSource {
     }
 }
 
+/// Worse depth than the capture's, to measure how the fit copes: Gaussian noise on every depth
+/// pixel and views without depth.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct DepthDegradation {
+    /// Standard deviation of the noise added to every measured depth (mm; 0: none).
+    pub noise_mm: f32,
+    /// Every this many training views (from the second) lose their depth map (0: none).
+    pub drop_every: usize,
+}
+
+impl DepthDegradation {
+    /// Applies the degradation to `dataset`, reproducibly for `seed`.
+    pub fn apply(&self, dataset: &mut crate::data::Dataset, seed: u64) {
+        let mut rng = Rng::new(seed);
+        for views in &mut dataset.views {
+            let train = views.split == crate::data::Split::Train;
+            for (i, frame) in views.frames.iter_mut().enumerate() {
+                if train && self.drop_every > 0 && i % self.drop_every == 1 % self.drop_every {
+                    frame.depth = None;
+                    continue;
+                }
+                let Some(depth) = frame.depth.as_mut().filter(|_| self.noise_mm > 0.0) else {
+                    continue;
+                };
+                for mm in depth.millimetres.iter_mut().filter(|mm| **mm > 0) {
+                    // Box–Muller: a standard normal from two uniforms.
+                    let (u, w) = (rng.uniform(1e-7, 1.0), rng.uniform(0.0, 1.0));
+                    let n = (-2.0 * u.ln()).sqrt() * (std::f32::consts::TAU * w).cos();
+                    *mm = (f32::from(*mm) + self.noise_mm * n)
+                        .round()
+                        .clamp(1.0, 65535.0) as u16;
+                }
+            }
+        }
+    }
+}
+
 /// Fits the suite's objects (all, or those whose id contains one of `only`) and scores them.
 /// With `ablations`, each object's reconstruction is also re-articulated without each
 /// consistency component, and reconstructed and articulated once more with global remeshing.
@@ -702,6 +740,7 @@ pub fn fit(
     config: &crate::fit::object::FitConfig,
     source: &SuiteSource,
     only: &[String],
+    degrade: &DepthDegradation,
     ablations: bool,
     log: &mut dyn FnMut(&FitObject),
 ) -> Result<FitBench, String> {
@@ -727,7 +766,8 @@ pub fn fit(
             continue;
         }
         let named = |e: String| format!("{id}: {e}");
-        let dataset = source.load(ctx, &object)?;
+        let mut dataset = source.load(ctx, &object)?;
+        degrade.apply(&mut dataset, 17);
         let category = object.category.clone();
         let score = |fit: &ObjectFit| -> Result<crate::eval::ObjectMetrics, String> {
             fit.evaluate(&dataset, &id, &category, &options)
@@ -831,6 +871,7 @@ pub fn fit(
         bench: "fit",
         adapter: ctx.adapter.clone(),
         suite: source.clone(),
+        depth_degradation: *degrade,
         config: *config,
         capture,
         by_part_count: BenchmarkTable::by_part_count(&metrics),

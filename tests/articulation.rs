@@ -211,23 +211,11 @@ fn measured_capture(spec: &mut artmesh::render::RenderSpec) {
 fn measured_joints_survive_noisy_and_missing_depth() {
     let ctx = common::context();
     let noisy = |d: &mut artmesh::data::Dataset| {
-        let mut rng = artmesh::rng::Rng::new(11);
-        for v in &mut d.views {
-            for (i, f) in v.frames.iter_mut().enumerate() {
-                if i % 2 == 1 && v.split == Split::Train {
-                    f.depth = None;
-                    continue;
-                }
-                for mm in &mut f.depth.as_mut().unwrap().millimetres {
-                    if *mm > 0 {
-                        // Box–Muller: a standard normal from two uniforms.
-                        let (u, w) = (rng.uniform(1e-6, 1.0), rng.uniform(0.0, 1.0));
-                        let n = (-2.0 * u.ln()).sqrt() * (std::f32::consts::TAU * w).cos();
-                        *mm = (f32::from(*mm) + 4.0 * n).round().clamp(1.0, 65535.0) as u16;
-                    }
-                }
-            }
-        }
+        let degrade = artmesh::bench::DepthDegradation {
+            noise_mm: 4.0,
+            drop_every: 2,
+        };
+        degrade.apply(d, 11);
     };
     let (dataset, fit) = pollster::block_on(tiny_fit(
         &ctx,

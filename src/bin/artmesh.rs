@@ -406,6 +406,12 @@ mod cli {
             /// photometric stages), off (the paper's method) [default: settle; off for paper].
             #[arg(long, value_parser = ["off", "seed", "settle"])]
             geometry: Option<String>,
+            /// Add Gaussian noise of this standard deviation (mm) to every depth pixel before fitting.
+            #[arg(long, default_value_t = 0.0)]
+            depth_noise: f32,
+            /// Drop the depth map of every N-th training view before fitting (0: none).
+            #[arg(long, default_value_t = 0)]
+            drop_depth_every: usize,
             /// Also run the four ablations (w/o vertex colour, w/o vertex opacity, w/o backward pass,
             /// w/o part-aware remeshing) on every object.
             #[arg(long)]
@@ -876,10 +882,17 @@ mod cli {
                             },
                         articulation_iterations,
                         geometry,
+                        depth_noise,
+                        drop_depth_every,
                         ablations,
                         markdown,
                     },
             } => {
+                if !(0.0..=1000.0).contains(&depth_noise) {
+                    return Err(format!(
+                        "--depth-noise: expected a standard deviation from 0 to 1000 mm, found {depth_noise}"
+                    ));
+                }
                 let mut config = fit_config(&preset)?;
                 if let Some(n) = articulation_iterations {
                     config.articulation.iterations = n;
@@ -905,6 +918,10 @@ mod cli {
                     &config,
                     &source,
                     &objects,
+                    &artmesh::bench::DepthDegradation {
+                        noise_mm: depth_noise,
+                        drop_every: drop_depth_every,
+                    },
                     ablations,
                     &mut |o| {
                         let m = &o.metrics;
