@@ -476,8 +476,9 @@ fn best_revolute(pair: &CloudPair, seed: PartMotion, anchor: Option<&Anchor>) ->
     most_plausible(&fits, pair, anchor).unwrap_or(seed)
 }
 
-/// The best translation: from the registration's slide and from where the best revolute motion
-/// takes the part's centroid (a drawer seen deeper when open pulls the centroids apart).
+/// The best translation: from the registration's slide, from where the best revolute motion
+/// takes the part's centroid (a drawer seen deeper when open pulls the centroids apart), and
+/// from 0.7 to 1.3 times the slide.
 fn best_prismatic(pair: &CloudPair, seed: PartMotion, revolute: &PartMotion) -> PartMotion {
     let n = pair.start.points.len().max(1) as f64;
     let centroid = pair
@@ -487,11 +488,15 @@ fn best_prismatic(pair: &CloudPair, seed: PartMotion, revolute: &PartMotion) -> 
         .map(|p| p.as_dvec3())
         .sum::<DVec3>()
         / n;
+    // A slide seen partly (a drawer's sides hidden when closed) can stop short of or past the
+    // travel: starts along the seed's direction at a range of fractions of it, too.
+    let along = [0.7, 0.85, 1.15, 1.3].map(|f| PartMotion::prismatic(seed.translation * f));
     [
         seed,
         PartMotion::prismatic(revolute.forward(centroid) - centroid),
     ]
     .into_iter()
+    .chain(along)
     .map(|m| {
         let m = refine(pair, Model::Prismatic, m, 40);
         (pair.residual(&m), m)
