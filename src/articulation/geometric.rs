@@ -111,12 +111,15 @@ impl Model {
     }
 }
 
-/// One match: a source point (in its own state), the target point and the target's normal, and
-/// whether the source is the start cloud (moved by g⁺) or the end cloud (moved by g⁻).
+/// One match: a source point (in its own state), the target point and the target's normal, their
+/// colour difference, and whether the source is the start cloud (moved by g⁺) or the end cloud
+/// (moved by g⁻).
 struct Match {
     x: DVec3,
     q: DVec3,
     n: DVec3,
+    /// Mean absolute colour difference of the two points (0 without colours).
+    color: f64,
     forward: bool,
 }
 
@@ -162,16 +165,23 @@ impl<'a> CloudPair<'a> {
             let mut side: Vec<(f64, Match)> = from
                 .points
                 .iter()
-                .filter_map(|p| {
+                .enumerate()
+                .filter_map(|(k, p)| {
                     let x = p.as_dvec3();
                     let y = if forward { m.forward(x) } else { m.backward(x) };
                     let (i, d2) = tree.nearest_index(y.as_vec3())?;
+                    let color = from
+                        .colors
+                        .get(k)
+                        .zip(to.colors.get(i))
+                        .map_or(0.0, |(a, b)| f64::from((*a - *b).abs().element_sum()) / 3.0);
                     Some((
                         d2,
                         Match {
                             x,
                             q: to.points[i].as_dvec3(),
                             n: to.normals[i].as_dvec3(),
+                            color,
                             forward,
                         },
                     ))
@@ -185,34 +195,11 @@ impl<'a> CloudPair<'a> {
     }
 
     /// Mean colour difference (0–1 per channel, mean over RGB) between each point moved by `m`
-    /// and its nearest neighbour in the other state, over the closest [`KEEP`] of the matches
-    /// in both directions: what tells apart motions the shape alone cannot (a knob's pointer
-    /// mark, a door's two faces).
+    /// and its match in the other state, over the kept matches of both directions: what tells
+    /// apart motions the shape alone cannot (a knob's pointer mark, a door's two faces).
     pub fn color_residual(&self, m: &PartMotion) -> f64 {
-        let mut diffs = Vec::new();
-        for forward in [true, false] {
-            let (from, to, tree) = if forward {
-                (self.start, self.end, &self.end_tree)
-            } else {
-                (self.end, self.start, &self.start_tree)
-            };
-            let mut side: Vec<(f64, f64)> = from
-                .points
-                .iter()
-                .zip(&from.colors)
-                .filter_map(|(p, c)| {
-                    let x = p.as_dvec3();
-                    let y = if forward { m.forward(x) } else { m.backward(x) };
-                    let (i, d2) = tree.nearest_index(y.as_vec3())?;
-                    let other = to.colors.get(i)?;
-                    Some((d2, f64::from((*c - *other).abs().element_sum()) / 3.0))
-                })
-                .collect();
-            side.sort_by(|a, b| a.0.total_cmp(&b.0));
-            side.truncate((side.len() as f64 * KEEP).ceil() as usize);
-            diffs.extend(side.into_iter().map(|d| d.1));
-        }
-        diffs.iter().sum::<f64>() / diffs.len().max(1) as f64
+        let matches = self.matches(m);
+        matches.iter().map(|c| c.color).sum::<f64>() / matches.len().max(1) as f64
     }
 
     /// Trimmed RMS point-to-plane residual (m) of `m`, both directions.
