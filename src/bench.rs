@@ -591,6 +591,51 @@ pub enum SuiteSource {
     },
 }
 
+/// What a suite folder's `suite.json` (written by `artmesh suite`) lists: each object's id (its
+/// folder) and category, and how the suite was captured when it says.
+pub struct SuiteListing {
+    pub objects: Vec<(String, String)>,
+    pub capture: Option<CaptureSettings>,
+}
+
+/// Reads `dir/suite.json`.
+pub fn read_suite_listing(dir: &std::path::Path) -> Result<SuiteListing, String> {
+    #[derive(serde::Deserialize)]
+    struct Manifest {
+        objects: Vec<Entry>,
+        capture: Option<Capture>,
+    }
+    #[derive(serde::Deserialize)]
+    struct Capture {
+        width: u32,
+        train_views: usize,
+    }
+    #[derive(serde::Deserialize)]
+    struct Entry {
+        id: String,
+        category: String,
+    }
+    let path = dir.join("suite.json");
+    let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
+        format!(
+            "{}: expected a suite manifest ({{\"objects\": [{{\"id\", \"category\"}}]}}): {e}",
+            path.display()
+        )
+    })?;
+    Ok(SuiteListing {
+        objects: manifest
+            .objects
+            .into_iter()
+            .map(|o| (o.id, o.category))
+            .collect(),
+        capture: manifest.capture.map(|c| CaptureSettings {
+            size: c.width,
+            train_views: c.train_views,
+        }),
+    })
+}
+
 /// One object listed by a [`SuiteSource`].
 struct SourceObject {
     id: String,
@@ -617,57 +662,35 @@ impl SuiteSource {
                 },
             )),
             SuiteSource::Dir(dir) => {
-                let path = dir.join("suite.json");
-                let text = std::fs::read_to_string(&path)
-                    .map_err(|e| format!("{}: {e}", path.display()))?;
-                #[derive(serde::Deserialize)]
-                struct Manifest {
-                    objects: Vec<Entry>,
-                    capture: Capture,
-                }
-                #[derive(serde::Deserialize)]
-                struct Capture {
-                    width: u32,
-                    train_views: usize,
-                }
-                #[derive(serde::Deserialize)]
-                struct Entry {
-                    id: String,
-                    category: String,
-                }
-                let manifest: Manifest = serde_json::from_str(&text).map_err(|e| {
-                    format!(
-                        "{}: expected a suite manifest ({{\"objects\": [{{\"id\", \"category\"}}]}}): {e}",
-                        path.display()
-                    )
-                })?;
-                let capture = CaptureSettings {
-                    size: manifest.capture.width,
-                    train_views: manifest.capture.train_views,
-                };
-                let objects = manifest
+                let listing = read_suite_listing(dir)?;
+                let objects = listing
                     .objects
                     .into_iter()
-                    .map(|o| {
+                    .map(|(id, category)| {
                         // Ids name folders inside the suite: nothing that could leave it.
-                        let plain = !o.id.is_empty()
-                            && o.id
+                        let plain = !id.is_empty()
+                            && id
                                 .chars()
                                 .all(|c| c.is_ascii_alphanumeric() || c == '_' || c == '-');
                         if !plain {
                             return Err(format!(
-                                "{}: object id {:?} is not a plain folder name",
-                                path.display(),
-                                o.id
+                                "{}: object id {id:?} is not a plain folder name",
+                                dir.join("suite.json").display()
                             ));
                         }
                         Ok(SourceObject {
-                            id: o.id,
-                            category: o.category,
+                            id,
+                            category,
                             entry: None,
                         })
                     })
                     .collect::<Result<_, _>>()?;
+                let capture = listing.capture.ok_or_else(|| {
+                    format!(
+                        "{}: no \"capture\" settings (written by `artmesh suite`)",
+                        dir.join("suite.json").display()
+                    )
+                })?;
                 Ok((objects, capture))
             }
         }
@@ -683,13 +706,7 @@ impl SuiteSource {
             (SuiteSource::Capture { size, views, .. }, Some(entry)) => {
                 capture_entry(ctx, entry, *size, *views, 2)
             }
-            (SuiteSource::Dir(dir), _) => {
-                let folder = dir.join(&object.id);
-                let files = crate::data::read_dir(&folder)
-                    .map_err(|e| format!("{}: {e}", folder.display()))?;
-                crate::data::Dataset::from_files(&files)
-                    .map_err(|e| format!("{}: {} problem(s):\n{e}", folder.display(), e.0.len()))
-            }
+            (SuiteSource::Dir(dir), _) => crate::data::read_dataset(&dir.join(&object.id)),
             _ => Err(format!("{}: no capture plan", object.id)),
         }
     }

@@ -643,7 +643,7 @@ mod cli {
                         artmesh::fit::articulate::GeometryUse::parse(&g)?;
                 }
                 capture::fresh_folder(&out)?;
-                let dataset = load_dataset(&root)?;
+                let dataset = data::read_dataset(&root)?;
                 let id = root
                     .file_name()
                     .map_or("object".into(), |n| n.to_string_lossy().into_owned());
@@ -963,7 +963,7 @@ mod cli {
             } => {
                 let config = fit_config(&preset)?;
                 let change = artmesh::bench::SpreadChange::parse(&vary)?;
-                let dataset = load_dataset(&root)?;
+                let dataset = data::read_dataset(&root)?;
                 let ctx = context()?;
                 let report = artmesh::bench::spread(
                     &ctx,
@@ -1194,13 +1194,6 @@ mod cli {
         Ok(config)
     }
 
-    /// Reads the dataset folder `root`; every problem found is listed in the error.
-    fn load_dataset(root: &Path) -> Result<Dataset, String> {
-        let files = data::read_dir(root).map_err(|e| e.to_string())?;
-        Dataset::from_files(&files)
-            .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))
-    }
-
     /// Loads `root`, reconstructs it with `config` (a progress bar on stderr), writes the part
     /// meshes and report.json under `out` and returns the report.
     fn reconstruct(
@@ -1208,7 +1201,7 @@ mod cli {
         out: &Path,
         config: &artmesh::fit::reconstruct::ReconstructionConfig,
     ) -> Result<eval::ReconstructionReport, String> {
-        let dataset = load_dataset(root)?;
+        let dataset = data::read_dataset(root)?;
         let ctx = context()?;
         let mut bar = progress::Bar::new("reconstruct");
         let reconstruction = pollster::block_on(artmesh::fit::reconstruct::reconstruct(
@@ -1331,34 +1324,11 @@ mod cli {
         samples: u32,
         markdown: bool,
     ) -> Result<ExitCode, String> {
-        #[derive(serde::Deserialize)]
-        struct Manifest {
-            objects: Vec<Entry>,
-        }
-        #[derive(serde::Deserialize)]
-        struct Entry {
-            id: String,
-            category: String,
-        }
-        let path = gt.join("suite.json");
-        let text = std::fs::read(&path).map_err(|e| format!("{}: {e}", path.display()))?;
-        let manifest: Manifest = serde_json::from_slice(&text).map_err(|e| {
-            format!(
-                "{}: expected a suite manifest ({{\"objects\": [{{\"id\", \"category\"}}]}}): {e}",
-                path.display()
-            )
-        })?;
-        let mut reports = Vec::with_capacity(manifest.objects.len());
-        for o in &manifest.objects {
-            let report = evaluate(
-                &pred.join(&o.id),
-                &gt.join(&o.id),
-                state,
-                &o.id,
-                &o.category,
-                samples,
-            )
-            .map_err(|e| format!("{}: {e}", o.id))?;
+        let listing = artmesh::bench::read_suite_listing(gt)?;
+        let mut reports = Vec::with_capacity(listing.objects.len());
+        for (id, category) in &listing.objects {
+            let report = evaluate(&pred.join(id), &gt.join(id), state, id, category, samples)
+                .map_err(|e| format!("{id}: {e}"))?;
             reports.push(report);
         }
         let by_parts = eval::BenchmarkTable::by_part_count(&reports);

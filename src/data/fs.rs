@@ -7,6 +7,14 @@ use std::path::{Component, Path};
 use super::FileSet;
 use super::error::DataError;
 
+/// Reads the dataset folder `root` (see [`read_dir`]) and validates it; every problem found is
+/// listed in the error, after the folder's name.
+pub fn read_dataset(root: &Path) -> Result<super::Dataset, String> {
+    let files = read_dir(root).map_err(|e| e.to_string())?;
+    super::Dataset::from_files(&files)
+        .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))
+}
+
 /// Folders nested deeper than this are not followed (guards against symlink loops).
 const MAX_DEPTH: usize = 32;
 

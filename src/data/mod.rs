@@ -39,7 +39,7 @@ pub use camera::{Camera, Intrinsics, look_at};
 pub use dataset::{Dataset, Frame, GroundTruth, SemanticFormat, ViewSet, WriteOptions};
 pub use error::{DataError, DatasetErrors};
 #[cfg(not(target_arch = "wasm32"))]
-pub use fs::{read_dir, write_dir};
+pub use fs::{read_dataset, read_dir, write_dir};
 pub use gt::{GtJoint, GtMeshes, JointKind};
 pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png};
 pub use npy::encode_npy;

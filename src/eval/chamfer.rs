@@ -126,48 +126,16 @@ pub struct KdTree {
 impl KdTree {
     /// Builds the tree (O(n log² n)); non-finite points are the caller's concern (they never match closer).
     pub fn new(points: &[Vec3]) -> Self {
-        let mut tree = KdTree {
-            points: points.to_vec(),
-            axis: vec![0; points.len()],
-            input: (0..points.len() as u32).collect(),
-        };
-        tree.build(0, points.len());
-        tree
-    }
-
-    fn build(&mut self, lo: usize, hi: usize) {
-        if hi - lo <= LEAF_SIZE {
-            return;
+        // Each point travels with its input index through the build.
+        let mut entries: Vec<(Vec3, u32)> = points.iter().copied().zip(0..).collect();
+        let mut axis = vec![0; points.len()];
+        build(&mut entries, &mut axis, 0, points.len());
+        let (points, input) = entries.into_iter().unzip();
+        KdTree {
+            points,
+            axis,
+            input,
         }
-        let (min, max) = self.points[lo..hi]
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(mn, mx), &p| {
-                (mn.min(p), mx.max(p))
-            });
-        // Split the widest extent: keeps cells compact, so queries prune well.
-        let extent = max - min;
-        let axis = if extent.x >= extent.y && extent.x >= extent.z {
-            0
-        } else if extent.y >= extent.z {
-            1
-        } else {
-            2
-        };
-        let m = lo + (hi - lo) / 2;
-        // Points and their input indices move together.
-        let mut order: Vec<(Vec3, u32)> = self.points[lo..hi]
-            .iter()
-            .copied()
-            .zip(self.input[lo..hi].iter().copied())
-            .collect();
-        order.select_nth_unstable_by(m - lo, |a, b| a.0[axis].total_cmp(&b.0[axis]));
-        for (i, (p, k)) in order.into_iter().enumerate() {
-            self.points[lo + i] = p;
-            self.input[lo + i] = k;
-        }
-        self.axis[m] = axis as u8;
-        self.build(lo, m);
-        self.build(m + 1, hi);
     }
 
     /// Number of points.
@@ -187,17 +155,21 @@ impl KdTree {
 
     /// The point nearest to `q` and its squared distance; `None` for an empty tree.
     pub fn nearest(&self, q: Vec3) -> Option<(Vec3, f64)> {
-        let mut best = (f64::INFINITY, usize::MAX);
-        self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
-        self.points.get(best.1).map(|&p| (p, best.0))
+        self.nearest_slot(q).map(|(i, d2)| (self.points[i], d2))
     }
 
     /// The input index of the point nearest to `q` and its squared distance; `None` for an
     /// empty tree.
     pub fn nearest_index(&self, q: Vec3) -> Option<(usize, f64)> {
+        self.nearest_slot(q)
+            .map(|(i, d2)| (self.input[i] as usize, d2))
+    }
+
+    /// Where in the tree's order the point nearest to `q` is stored, and its squared distance.
+    fn nearest_slot(&self, q: Vec3) -> Option<(usize, f64)> {
         let mut best = (f64::INFINITY, usize::MAX);
         self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
-        self.input.get(best.1).map(|&i| (i as usize, best.0))
+        (best.1 < self.points.len()).then_some((best.1, best.0))
     }
 
     fn search(&self, q: glam::DVec3, lo: usize, hi: usize, best: &mut (f64, usize)) {
@@ -229,6 +201,33 @@ impl KdTree {
             self.search(q, far.0, far.1, best);
         }
     }
+}
+
+/// Orders `entries[lo..hi]` as the implicit tree (see [`KdTree`]), recording each splitting
+/// point's axis in `axis`.
+fn build(entries: &mut [(Vec3, u32)], axis: &mut [u8], lo: usize, hi: usize) {
+    if hi - lo <= LEAF_SIZE {
+        return;
+    }
+    let (min, max) = entries[lo..hi]
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(mn, mx), &(p, _)| {
+            (mn.min(p), mx.max(p))
+        });
+    // Split the widest extent: keeps cells compact, so queries prune well.
+    let extent = max - min;
+    let split = if extent.x >= extent.y && extent.x >= extent.z {
+        0
+    } else if extent.y >= extent.z {
+        1
+    } else {
+        2
+    };
+    let m = lo + (hi - lo) / 2;
+    entries[lo..hi].select_nth_unstable_by(m - lo, |a, b| a.0[split].total_cmp(&b.0[split]));
+    axis[m] = split as u8;
+    build(entries, axis, lo, m);
+    build(entries, axis, m + 1, hi);
 }
 
 /// Mean NN distance and mean squared NN distance from every point of `from` to the points in `to`.

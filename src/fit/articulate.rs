@@ -169,8 +169,8 @@ pub struct ArticulationConfig {
     pub geometry: GeometryUse,
     /// How those surfaces are sampled.
     pub clouds: CloudOptions,
-    /// A stage stops early once its reported loss changes by less than this fraction between
-    /// two reports (0: never).
+    /// The refinement stops early once its reported objective changes by less than this fraction
+    /// between two reports (0: never).
     pub flat_tolerance: f64,
     pub ablation: Ablation,
     /// Loss terms are read back (and reported) every this many steps.
@@ -655,14 +655,6 @@ fn backward_maps(motions: &[PartMotion]) -> Vec<(DMat3, DVec3)> {
 const STILL_ANGLE_DEG: f64 = 0.5;
 const STILL_DISTANCE_M: f64 = 0.002;
 
-/// The joints the dataset's depth and part maps measure: per movable part the geometric fit
-/// on the training views' clouds, and the pairs of the test views' clouds (the training ones
-/// when there are no test views) that judge a refined joint against its seed.
-struct Measured<'a> {
-    joints: Vec<Option<GeometricJoint>>,
-    judges: Vec<Option<CloudPair<'a>>>,
-}
-
 /// Points of the rest of the object a measured joint's axis is checked against.
 const ANCHOR_POINTS: usize = 20_000;
 
@@ -677,44 +669,33 @@ fn observe(
         .flatten()
 }
 
-impl<'a> Measured<'a> {
-    fn new(
-        k: usize,
-        train: Option<&'a [ObservedState; 2]>,
-        test: Option<&'a [ObservedState; 2]>,
-    ) -> Self {
-        let usable = |c: &crate::articulation::observed::PartCloud| c.points.len() >= 3;
-        let joints = (0..k)
-            .map(|part| {
-                let [s, e] = train?;
-                let anchor = Anchor::new(
-                    &s.others(part, ANCHOR_POINTS),
-                    &e.others(part, ANCHOR_POINTS),
-                );
-                (part > 0)
-                    .then(|| fit_joint(&s.parts[part], &e.parts[part], Some(&anchor)))
-                    .flatten()
-            })
-            .collect();
-        let judges = (0..k)
-            .map(|part| {
-                let [s, e] = test.or(train)?;
-                let (a, b) = (&s.parts[part], &e.parts[part]);
-                (part > 0 && usable(a) && usable(b)).then(|| CloudPair::new(a, b))
-            })
-            .collect();
-        Self { joints, judges }
-    }
+/// The joints the training views' depth and part maps measure, one per part (`None` for the
+/// base and for a part not measured in both states).
+fn measure_joints(k: usize, train: Option<&[ObservedState; 2]>) -> Vec<Option<GeometricJoint>> {
+    (0..k)
+        .map(|part| {
+            let [s, e] = train.filter(|_| part > 0)?;
+            let anchor = Anchor::new(
+                &s.others(part, ANCHOR_POINTS),
+                &e.others(part, ANCHOR_POINTS),
+            );
+            fit_joint(&s.parts[part], &e.parts[part], Some(&anchor))
+        })
+        .collect()
 }
 
-/// What a user should know about the measurements: views without depth or part maps, no test
-/// views to judge by. A movable part that no training view of either state shows (not one
-/// pixel labelled with it) is an error: there is nothing to fit it to.
-fn measurement_warnings(
-    clouds: &[ObservedState; 2],
-    has_test_views: bool,
-    warnings: &mut Vec<String>,
-) -> GpuResult<()> {
+/// The cloud pair judging a refined joint of `part` against its measured seed: the test views'
+/// (`clouds`), or `None` when either state has fewer than 3 points of the part.
+fn judge(clouds: &[ObservedState; 2], part: usize) -> Option<CloudPair<'_>> {
+    let [s, e] = clouds;
+    let (a, b) = (&s.parts[part], &e.parts[part]);
+    (a.points.len() >= 3 && b.points.len() >= 3).then(|| CloudPair::new(a, b))
+}
+
+/// What a user should know about the measurements: views without depth or part maps. A movable
+/// part that no training view of either state shows (not one pixel labelled with it) is an
+/// error: there is nothing to fit it to.
+fn measurement_warnings(clouds: &[ObservedState; 2], warnings: &mut Vec<String>) -> GpuResult<()> {
     for (state, c) in [State::Start, State::End].iter().zip(clouds) {
         if c.views_with_depth < c.views {
             warnings.push(format!(
@@ -735,11 +716,6 @@ fn measurement_warnings(
             "movable part(s) {} appear in no training view's part map (with depth) in either state: nothing to fit their joints to; check the semantic maps' ids (0 = background, k + 1 = part k)",
             unseen.join(", ")
         )));
-    }
-    if !has_test_views {
-        warnings.push(
-            "the dataset has no test views: refined joints are judged against their measured seeds on the training views' points".into(),
-        );
     }
     Ok(())
 }
@@ -871,18 +847,24 @@ pub async fn articulate(
     let mut prismatic = pick(|c| c.prismatic);
     // The measured joints: seeds where there are, and the settled parts out of the photometry.
     let train_clouds = observe(dataset, config, Split::Train);
-    let test_clouds = observe(dataset, config, Split::Test);
     if let Some(clouds) = &train_clouds {
-        measurement_warnings(clouds, test_clouds.is_some(), &mut warnings)?;
+        measurement_warnings(clouds, &mut warnings)?;
+        let has_test_views = [State::Start, State::End]
+            .iter()
+            .all(|&s| dataset.views(s, Split::Test).is_some());
+        if !has_test_views {
+            warnings.push(
+                "the dataset has no test views: refined joints are judged against their measured seeds on the training views' points".into(),
+            );
+        }
     }
-    let measured = Measured::new(k, train_clouds.as_ref(), test_clouds.as_ref());
+    let measured = measure_joints(k, train_clouds.as_ref());
     let settled: Vec<bool> = measured
-        .joints
         .iter()
         .map(|g| config.geometry == GeometryUse::Settle && g.is_some_and(|g| g.settled()))
         .collect();
     for part in 1..k {
-        if let Some(g) = &measured.joints[part] {
+        if let Some(g) = &measured[part] {
             revolute[part] = g.revolute;
             prismatic[part] = g.prismatic;
         }
@@ -968,7 +950,7 @@ pub async fn articulate(
     let t_bake = now_seconds();
     checkpoint(observer, &event(Phase::BakeOff, 0, (k - 1) as u32, None)).await?;
     let mut kinds: Vec<JointKind> = (0..k)
-        .map(|p| measured.joints[p].map_or(JointKind::Revolute, |g| g.kind))
+        .map(|p| measured[p].map_or(JointKind::Revolute, |g| g.kind))
         .collect();
     let mut bake_offs: Vec<BakeOff> = kinds
         .iter()
@@ -1011,7 +993,7 @@ pub async fn articulate(
             }
         };
         // Both models' evidence: the measured residuals' and the bake-off's log ratios.
-        let kind = match &measured.joints[part] {
+        let kind = match &measured[part] {
             Some(g) if pixels > 0 => combined_kind(g, rot, trans),
             Some(g) if g.observable => g.kind,
             _ => kind,
@@ -1135,9 +1117,17 @@ pub async fn articulate(
     }
     times.refine_s = now_seconds() - t_refine;
 
+    // The clouds that judge refined joints against their measured seeds, observed only when a
+    // measured joint was refined: the test views', else the training views'.
+    let refined_measured = (1..k).any(|p| trainable[p] && measured[p].is_some());
+    let test_clouds = refined_measured
+        .then(|| observe(dataset, config, Split::Test))
+        .flatten();
+    let judging = test_clouds.as_ref().or(train_clouds.as_ref());
+
     let joints: Vec<FittedJoint> = (1..k)
         .map(|part| {
-            let geometry = measured.joints[part];
+            let geometry = measured[part];
             let kind = kinds[part];
             let (mut motion, mut axis_registration) =
                 if config.register_magnitude && trainable[part] {
@@ -1153,11 +1143,12 @@ pub async fn articulate(
                 "none"
             };
             // Never worse than the measured seed on the held-out measurements.
-            if let (Some(g), Some(judge), true) =
-                (geometry, &measured.judges[part], trainable[part])
-            {
+            let pair = judging
+                .filter(|_| trainable[part])
+                .and_then(|c| judge(c, part));
+            if let (Some(g), Some(pair)) = (geometry, pair) {
                 let seed = g.motion(kind);
-                if judge.residual(&seed) < judge.residual(&motion) {
+                if pair.residual(&seed) < pair.residual(&motion) {
                     motion = seed;
                     axis_registration = None;
                     decided_by = "geometry (kept over the refinement)";
