@@ -6,12 +6,12 @@
 #![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::data::{GtJoint, GtMeshes, JointKind, TriMesh};
-use artmesh::eval::chamfer::KdTree;
 use artmesh::eval::{
     BenchmarkTable, ChamferOptions, EvalError, EvalOptions, ObjectMetrics, PartBucket, Solver,
     axis_angle_deg, axis_line_distance, axis_pos, chamfer_meshes, evaluate_object, match_joints,
     match_joints_using, motion_error, sample_surface,
 };
+use artmesh::mesh::spatial::KdTree;
 use artmesh::rng::Rng;
 use glam::Vec3;
 
