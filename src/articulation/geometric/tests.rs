@@ -1,6 +1,8 @@
 //! Unit tests of the geometric joint fit: a door swing, a drawer slide against a far hinge, and a
 //! knob turned about its own axis.
 
+use glam::Vec3;
+
 use super::*;
 use crate::articulation::motion::rotation_axis_angle;
 use crate::rng::Rng;
