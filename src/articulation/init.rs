@@ -12,7 +12,7 @@ use glam::{DMat3, DQuat, DVec3, Vec3};
 use serde::Serialize;
 
 use super::motion::{PartMotion, closest_on_line, rotation_axis_angle};
-use crate::eval::chamfer::KdTree;
+use crate::mesh::spatial::KdTree;
 
 /// Eigen-decomposition of a symmetric n × n matrix by cyclic Jacobi rotations: eigenvalues in
 /// decreasing order and the matching unit eigenvectors.

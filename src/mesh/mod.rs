@@ -1,10 +1,12 @@
 //! Mesh operations of the reconstruction phase, on the CPU copy of the mesh field: part-aware
 //! restricted Delaunay remeshing ([`restricted_delaunay`], [`part_aware_remesh`]) and the topology
 //! edits around it (densification splits, pruning, hardening, connectivity counts), and the
-//! closest-point queries the articulation phase matches vertices with ([`closest`]).
+//! closest-point queries the articulation phase matches vertices with ([`closest`]), and the k-d
+//! tree nearest-neighbour search over point sets ([`spatial`]).
 
 pub mod closest;
 mod restricted_delaunay;
+pub mod spatial;
 pub mod topology;
 
 pub use restricted_delaunay::{RemeshOptions, part_aware_remesh, restricted_delaunay};

@@ -31,6 +31,7 @@ mod kinematics;
 mod mesh_io;
 mod parts;
 mod primitives;
+pub mod sampling;
 mod urdf;
 
 use std::sync::Arc;

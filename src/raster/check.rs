@@ -10,8 +10,10 @@ use glam::Vec3;
 use serde::Serialize;
 
 use super::field::{GpuField, MeshField, SH_FLOATS};
-use super::rasterizer::{BASE_CHANNELS, RasterSettings, RasterState, Rasterizer, RenderImages};
+use super::rasterizer::Rasterizer;
 use super::reference;
+use super::settings::{BASE_CHANNELS, RasterSettings};
+use super::state::{RasterState, RenderImages};
 use crate::data::{Camera, look_at};
 use crate::gpu::{GpuContext, GpuResult};
 use crate::rng::Rng;
@@ -231,39 +233,9 @@ fn linear_functional(render: &RenderImages, weights: &[f32]) -> f64 {
         .sum()
 }
 
-/// Central finite differences of L = Σ G ⊙ O for every parameter group of `scene`, with the
-/// hard cut-offs smoothed away ([`RasterSettings::smooth`]). `probes_per_group` caps the number of
-/// elements checked per group (positions, opacity and small groups are checked whole).
-pub async fn check_gradients(
-    ctx: &GpuContext,
-    scene: &Scene,
-    seed: u64,
-    probes_per_group: usize,
-) -> GpuResult<Vec<GroupCheck>> {
-    let settings = scene.settings.smooth();
-    let raster = Rasterizer::new(ctx);
-    let field = GpuField::upload(ctx, &scene.field)?;
-    let k = scene.camera.intrinsics;
-    let parts = scene.field.num_parts;
-    let mut state = RasterState::new(ctx, k.width, k.height, parts as u32)?;
-    let npix = (k.width * k.height) as usize;
-    let mut rng = Rng::new(seed);
-    let weights: Vec<f32> = (0..(BASE_CHANNELS + parts) * npix)
-        .map(|_| rng.uniform(-1.0, 1.0))
-        .collect();
-
-    raster
-        .forward(ctx, &field, &mut state, &scene.camera, &settings)
-        .await?;
-    ctx.queue
-        .write_buffer(state.grad_render(), 0, bytemuck::cast_slice(&weights));
-    let mut encoder = ctx.device.create_command_encoder(&Default::default());
-    raster.encode_backward(ctx, &mut encoder, &field, &mut state);
-    ctx.queue.submit([encoder.finish()]);
-    let grads = field.read_gradients(ctx).await?;
-
-    // Probes: every position and opacity, a sample of each SH band and of the part logits.
-    let nv = scene.field.num_vertices();
+/// The elements to check: every position and opacity, `probes_per_group` random entries of each SH
+/// band and of the part logits (drawn from `rng` in that order).
+fn gradient_probes(nv: usize, parts: usize, probes_per_group: usize, rng: &mut Rng) -> Vec<Probe> {
     let mut probes = Vec::new();
     for i in 0..nv * 3 {
         probes.push(Probe {
@@ -299,6 +271,86 @@ pub async fn check_gradients(
             step: 1e-2,
         });
     }
+    probes
+}
+
+/// Per-group agreement of (group, finite difference, analytic) rows, groups in first-seen order.
+fn summarise(results: &[(Group, f64, f64)]) -> Vec<GroupCheck> {
+    let (rtol, atol) = (2e-2, 2e-3);
+    let mut groups: Vec<Group> = Vec::new();
+    for (g, _, _) in results {
+        if !groups.contains(g) {
+            groups.push(*g);
+        }
+    }
+    groups
+        .into_iter()
+        .map(|group| {
+            let rows: Vec<_> = results.iter().filter(|r| r.0 == group).collect();
+            let max_gradient = rows
+                .iter()
+                .map(|r| r.2.abs().max(r.1.abs()))
+                .fold(0.0, f64::max);
+            let failed = rows
+                .iter()
+                .filter(|r| {
+                    (r.1 - r.2).abs() > rtol * r.1.abs().max(r.2.abs()) + atol * max_gradient
+                })
+                .count();
+            let err2: f64 = rows.iter().map(|r| (r.1 - r.2).powi(2)).sum();
+            let ref2: f64 = rows.iter().map(|r| r.1.powi(2)).sum();
+            let max_relative = rows
+                .iter()
+                .filter(|r| r.1.abs().max(r.2.abs()) > 1e-2 * max_gradient)
+                .map(|r| (r.1 - r.2).abs() / r.1.abs().max(r.2.abs()))
+                .fold(0.0, f64::max);
+            GroupCheck {
+                group: group.name(),
+                checked: rows.len(),
+                failed,
+                relative_l2: (err2 / ref2.max(1e-300)).sqrt(),
+                max_relative,
+                max_gradient,
+                rtol,
+                atol,
+            }
+        })
+        .collect()
+}
+
+/// Central finite differences of L = Σ G ⊙ O for every parameter group of `scene`, with the
+/// hard cut-offs smoothed away ([`RasterSettings::smooth`]). `probes_per_group` caps the number of
+/// elements checked per group (positions, opacity and small groups are checked whole).
+pub async fn check_gradients(
+    ctx: &GpuContext,
+    scene: &Scene,
+    seed: u64,
+    probes_per_group: usize,
+) -> GpuResult<Vec<GroupCheck>> {
+    let settings = scene.settings.smooth();
+    let raster = Rasterizer::new(ctx);
+    let field = GpuField::upload(ctx, &scene.field)?;
+    let k = scene.camera.intrinsics;
+    let parts = scene.field.num_parts;
+    let mut state = RasterState::new(ctx, k.width, k.height, parts as u32)?;
+    let npix = (k.width * k.height) as usize;
+    let mut rng = Rng::new(seed);
+    let weights: Vec<f32> = (0..(BASE_CHANNELS + parts) * npix)
+        .map(|_| rng.uniform(-1.0, 1.0))
+        .collect();
+
+    raster
+        .forward(ctx, &field, &mut state, &scene.camera, &settings)
+        .await?;
+    ctx.queue
+        .write_buffer(state.grad_render(), 0, bytemuck::cast_slice(&weights));
+    let mut encoder = ctx.device.create_command_encoder(&Default::default());
+    raster.encode_backward(ctx, &mut encoder, &field, &mut state);
+    ctx.queue.submit([encoder.finish()]);
+    let grads = field.read_gradients(ctx).await?;
+
+    let nv = scene.field.num_vertices();
+    let probes = gradient_probes(nv, parts, probes_per_group, &mut rng);
 
     let mut results: Vec<(Group, f64, f64)> = Vec::new();
     for probe in &probes {
@@ -348,46 +400,7 @@ pub async fn check_gradients(
         results.push((probe.group, fd, f64::from(analytic)));
     }
 
-    let (rtol, atol) = (2e-2, 2e-3);
-    let mut groups: Vec<Group> = Vec::new();
-    for (g, _, _) in &results {
-        if !groups.contains(g) {
-            groups.push(*g);
-        }
-    }
-    Ok(groups
-        .into_iter()
-        .map(|group| {
-            let rows: Vec<_> = results.iter().filter(|r| r.0 == group).collect();
-            let max_gradient = rows
-                .iter()
-                .map(|r| r.2.abs().max(r.1.abs()))
-                .fold(0.0, f64::max);
-            let failed = rows
-                .iter()
-                .filter(|r| {
-                    (r.1 - r.2).abs() > rtol * r.1.abs().max(r.2.abs()) + atol * max_gradient
-                })
-                .count();
-            let err2: f64 = rows.iter().map(|r| (r.1 - r.2).powi(2)).sum();
-            let ref2: f64 = rows.iter().map(|r| r.1.powi(2)).sum();
-            let max_relative = rows
-                .iter()
-                .filter(|r| r.1.abs().max(r.2.abs()) > 1e-2 * max_gradient)
-                .map(|r| (r.1 - r.2).abs() / r.1.abs().max(r.2.abs()))
-                .fold(0.0, f64::max);
-            GroupCheck {
-                group: group.name(),
-                checked: rows.len(),
-                failed,
-                relative_l2: (err2 / ref2.max(1e-300)).sqrt(),
-                max_relative,
-                max_gradient,
-                rtol,
-                atol,
-            }
-        })
-        .collect())
+    Ok(summarise(&results))
 }
 
 /// A closed, slightly bumpy UV sphere of about `faces` triangles filling the middle of a

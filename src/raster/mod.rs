@@ -11,10 +11,11 @@ mod field;
 mod kernels;
 mod rasterizer;
 pub mod reference;
+mod settings;
+mod state;
 
 pub use field::{FieldGradients, GpuField, MeshField, SH_C0, SH_FLOATS, vertex_corners};
 pub use kernels::{MAX_PARTS, TILE};
-pub use rasterizer::{
-    BASE_CHANNELS, ForwardStats, RasterSettings, RasterState, Rasterizer, RenderImages, StageClock,
-    WorkCounts, sort_key_bits,
-};
+pub use rasterizer::{ForwardStats, Rasterizer};
+pub use settings::{BASE_CHANNELS, RasterSettings, sort_key_bits};
+pub use state::{RasterState, RenderImages, StageClock, WorkCounts};

@@ -6,7 +6,8 @@ use glam::{DVec2, DVec3};
 
 use super::field::{MeshField, SH_FLOATS};
 use super::kernels::LOG_DEPTH_RANGE;
-use super::rasterizer::{BASE_CHANNELS, RasterSettings, RenderImages, sort_key_bits};
+use super::settings::{BASE_CHANNELS, RasterSettings, sort_key_bits};
+use super::state::RenderImages;
 use crate::data::Camera;
 
 const C0: f64 = 0.282_094_791_773_878_14;

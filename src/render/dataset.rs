@@ -20,8 +20,8 @@ use crate::data::{
     Camera, DataError, DatasetWriter, FileSet, Frame, GtJoint, GtMeshes, JointKind as GtKind,
     Split, State, TriMesh, WriteOptions,
 };
-use crate::eval::chamfer::area_cdf;
 use crate::gpu::{GpuContext, GpuError};
+use crate::object::sampling::area_cdf;
 use crate::object::{ArticulatedObject, JointKind, mesh_bounds};
 use crate::rng::Rng;
 

@@ -1,0 +1,244 @@
+//! Trimmed point-to-plane registration of a part's start and end clouds under one motion model
+//! (revolute or prismatic): nearest-neighbour matches in both directions, the closest fraction
+//! kept, and Levenberg–Marquardt steps in the model's own parameters.
+
+use glam::{DQuat, DVec3};
+
+use crate::articulation::motion::{PartMotion, rotation_axis_angle};
+use crate::articulation::observed::PartCloud;
+use crate::mesh::spatial::KdTree;
+
+/// Fraction of matches kept (the rest: surface seen in one state only).
+const KEEP: f64 = 0.85;
+
+/// The parameters a model steps in, around a current motion.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(super) enum Model {
+    Revolute,
+    Prismatic,
+}
+
+impl Model {
+    /// Number of local parameters.
+    fn dims(self) -> usize {
+        match self {
+            Model::Revolute => 5,
+            Model::Prismatic => 3,
+        }
+    }
+
+    /// `m` changed by `delta` in this model's local parameters.
+    fn step(self, m: &PartMotion, delta: &[f64]) -> PartMotion {
+        match self {
+            Model::Prismatic => {
+                PartMotion::prismatic(m.translation + DVec3::new(delta[0], delta[1], delta[2]))
+            }
+            Model::Revolute => {
+                let (axis, angle) = rotation_axis_angle(m.rotation);
+                let (u, v) = axis.any_orthonormal_pair();
+                let axis = (axis + delta[1] * u + delta[2] * v).normalize();
+                PartMotion {
+                    rotation: DQuat::from_axis_angle(axis, angle + delta[0]),
+                    pivot: m.pivot + delta[3] * u + delta[4] * v,
+                    translation: DVec3::ZERO,
+                }
+            }
+        }
+    }
+}
+
+/// One match: a source point (in its own state), the target point and the target's normal, their
+/// colour difference, and whether the source is the start cloud (moved by g⁺) or the end cloud
+/// (moved by g⁻).
+struct Match {
+    x: DVec3,
+    q: DVec3,
+    n: DVec3,
+    /// Mean absolute colour difference of the two points (0 without colours).
+    color: f64,
+    forward: bool,
+}
+
+impl Match {
+    fn residual(&self, m: &PartMotion) -> f64 {
+        let y = if self.forward {
+            m.forward(self.x)
+        } else {
+            m.backward(self.x)
+        };
+        self.n.dot(y - self.q)
+    }
+}
+
+/// A part's two clouds with their search trees.
+pub struct CloudPair<'a> {
+    pub(super) start: &'a PartCloud,
+    pub(super) end: &'a PartCloud,
+    start_tree: KdTree,
+    end_tree: KdTree,
+}
+
+impl<'a> CloudPair<'a> {
+    /// Search trees over both clouds.
+    pub fn new(start: &'a PartCloud, end: &'a PartCloud) -> Self {
+        Self {
+            start,
+            end,
+            start_tree: KdTree::new(&start.points),
+            end_tree: KdTree::new(&end.points),
+        }
+    }
+
+    /// The kept (closest [`KEEP`]) matches of `m`, per direction.
+    fn matches(&self, m: &PartMotion) -> Vec<Match> {
+        let mut all = Vec::new();
+        for forward in [true, false] {
+            let (from, to, tree) = if forward {
+                (self.start, self.end, &self.end_tree)
+            } else {
+                (self.end, self.start, &self.start_tree)
+            };
+            let mut side: Vec<(f64, Match)> = from
+                .points
+                .iter()
+                .enumerate()
+                .filter_map(|(k, p)| {
+                    let x = p.as_dvec3();
+                    let y = if forward { m.forward(x) } else { m.backward(x) };
+                    let (i, d2) = tree.nearest_index(y.as_vec3())?;
+                    let color = from
+                        .colors
+                        .get(k)
+                        .zip(to.colors.get(i))
+                        .map_or(0.0, |(a, b)| f64::from((*a - *b).abs().element_sum()) / 3.0);
+                    Some((
+                        d2,
+                        Match {
+                            x,
+                            q: to.points[i].as_dvec3(),
+                            n: to.normals[i].as_dvec3(),
+                            color,
+                            forward,
+                        },
+                    ))
+                })
+                .collect();
+            side.sort_by(|a, b| a.0.total_cmp(&b.0));
+            side.truncate((side.len() as f64 * KEEP).ceil() as usize);
+            all.extend(side.into_iter().map(|(_, m)| m));
+        }
+        all
+    }
+
+    /// Mean colour difference (0–1 per channel, mean over RGB) between each point moved by `m`
+    /// and its match in the other state, over the kept matches of both directions: what tells
+    /// apart motions the shape alone cannot (a knob's pointer mark, a door's two faces).
+    pub fn color_residual(&self, m: &PartMotion) -> f64 {
+        let matches = self.matches(m);
+        matches.iter().map(|c| c.color).sum::<f64>() / matches.len().max(1) as f64
+    }
+
+    /// Trimmed RMS point-to-plane residual (m) of `m`, both directions.
+    pub fn residual(&self, m: &PartMotion) -> f64 {
+        rms(&self.matches(m), m)
+    }
+}
+
+/// Root mean square of the matches' point-to-plane residuals under `m`.
+fn rms(matches: &[Match], m: &PartMotion) -> f64 {
+    let sum: f64 = matches.iter().map(|c| c.residual(m).powi(2)).sum();
+    (sum / matches.len().max(1) as f64).sqrt()
+}
+
+/// Solves the n × n system `a x = b` (n ≤ 5) by Gaussian elimination with partial pivoting;
+/// `None` when singular.
+fn solve(mut a: [[f64; 5]; 5], mut b: [f64; 5], n: usize) -> Option<[f64; 5]> {
+    for col in 0..n {
+        let pivot = (col..n).max_by(|&i, &j| a[i][col].abs().total_cmp(&a[j][col].abs()))?;
+        if a[pivot][col].abs() < 1e-300 {
+            return None;
+        }
+        a.swap(col, pivot);
+        b.swap(col, pivot);
+        let (top, below) = a.split_at_mut(col + 1);
+        let pivot_row = top[col];
+        for (offset, row) in below.iter_mut().take(n - col - 1).enumerate() {
+            let f = row[col] / pivot_row[col];
+            for (x, p) in row[col..n].iter_mut().zip(&pivot_row[col..n]) {
+                *x -= f * p;
+            }
+            b[col + 1 + offset] -= f * b[col];
+        }
+    }
+    let mut x = [0.0; 5];
+    for row in (0..n).rev() {
+        let s: f64 = (row + 1..n).map(|k| a[row][k] * x[k]).sum();
+        x[row] = (b[row] - s) / a[row][row];
+    }
+    x.iter().all(|v| v.is_finite()).then_some(x)
+}
+
+/// Up to `steps` Levenberg–Marquardt steps on `model` from `m`, correspondences found again
+/// before every step.
+pub(super) fn refine(
+    pair: &CloudPair,
+    model: Model,
+    mut m: PartMotion,
+    steps: usize,
+) -> PartMotion {
+    let n = model.dims();
+    let mut lambda = 1e-3;
+    const H: f64 = 1e-7;
+    for _ in 0..steps {
+        let matches = pair.matches(&m);
+        if matches.len() < n {
+            break;
+        }
+        let (mut jtj, mut jtr) = ([[0.0; 5]; 5], [0.0; 5]);
+        let nudged: Vec<PartMotion> = (0..n)
+            .map(|j| {
+                let mut d = [0.0; 5];
+                d[j] = H;
+                model.step(&m, &d)
+            })
+            .collect();
+        for c in &matches {
+            let r = c.residual(&m);
+            let mut row = [0.0; 5];
+            for j in 0..n {
+                row[j] = (c.residual(&nudged[j]) - r) / H;
+            }
+            for i in 0..n {
+                jtr[i] += row[i] * r;
+                for j in 0..n {
+                    jtj[i][j] += row[i] * row[j];
+                }
+            }
+        }
+        let cost = rms(&matches, &m);
+        let mut improved = false;
+        for _ in 0..8 {
+            let mut a = jtj;
+            for (i, row) in a.iter_mut().enumerate().take(n) {
+                row[i] += lambda * jtj[i][i].max(1e-12);
+            }
+            let Some(delta) = solve(a, jtr.map(|v| -v), n) else {
+                lambda *= 10.0;
+                continue;
+            };
+            let next = model.step(&m, &delta[..n]);
+            if rms(&matches, &next) < cost {
+                let size: f64 = delta[..n].iter().map(|d| d * d).sum::<f64>().sqrt();
+                m = next;
+                lambda = (lambda / 3.0).max(1e-9);
+                improved = size > 1e-9;
+                break;
+            }
+            lambda *= 4.0;
+        }
+        if !improved {
+            break;
+        }
+    }
+    m
+}
