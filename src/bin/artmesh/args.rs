@@ -6,7 +6,6 @@ use artmesh::fit::reconstruct::{Preset, ReconstructionConfig, RemeshMode};
 use artmesh::gpu::GpuContext;
 use artmesh::render::RenderSpec;
 
-/// How objects are captured (defaults: the paper's Articulate-100 setting).
 /// Which suite objects a benchmark fits, and how they are captured.
 #[derive(clap::Args)]
 pub struct SuiteObjects {
@@ -24,6 +23,7 @@ pub struct SuiteObjects {
     pub views: usize,
 }
 
+/// How objects are captured (defaults: the paper's Articulate-100 setting).
 #[derive(clap::Args)]
 pub struct CaptureArgs {
     /// Image width in pixels [default: 800; 64 with --quick].

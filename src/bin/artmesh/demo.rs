@@ -10,6 +10,7 @@ use crate::args::{BudgetArgs, context, to_json};
 use crate::capture;
 use crate::fit::fit_and_write;
 
+/// `artmesh demo`'s arguments.
 #[derive(clap::Args)]
 pub struct DemoArgs {
     /// New folder to write [default: a fresh ./artmesh-demo, -2, -3, ...].

@@ -10,6 +10,7 @@ use artmesh::eval;
 use crate::args::to_json;
 use crate::suite::read_suite_listing;
 
+/// `artmesh eval`'s arguments.
 #[derive(clap::Args)]
 pub struct EvalArgs {
     /// Prediction: a folder laid out like a dataset's gt/ folder (trans.json,

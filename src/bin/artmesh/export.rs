@@ -9,6 +9,7 @@ use artmesh::object::ArticulatedObject;
 
 use crate::capture;
 
+/// `artmesh export`'s arguments.
 #[derive(clap::Args)]
 pub struct ExportArgs {
     /// Folder written by `fit` (or the `fit/` folder inside a `demo` folder).

@@ -13,6 +13,7 @@ use artmesh::fit::reconstruct::Progress;
 use crate::args::{BudgetArgs, context, reconstruction_config, to_json};
 use crate::{capture, progress};
 
+/// `artmesh fit`'s arguments.
 #[derive(clap::Args)]
 pub struct FitArgs {
     /// Dataset folder (ArtGS / MPArt-90 / PARIS layout, with depth and semantic maps).

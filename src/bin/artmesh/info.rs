@@ -8,6 +8,7 @@ use artmesh::gpu::selftest;
 
 use crate::args::{context, to_json};
 
+/// `artmesh info`'s arguments.
 #[derive(clap::Args)]
 pub struct InfoArgs {
     /// Dataset folder in the ArtGS / MPArt-90 / PARIS layout (transforms_*_{start,end}.json, ...).
@@ -17,6 +18,7 @@ pub struct InfoArgs {
     json: bool,
 }
 
+/// `artmesh gpu`'s arguments.
 #[derive(clap::Args)]
 pub struct GpuArgs {
     /// Largest input size for the self-test.
@@ -27,6 +29,7 @@ pub struct GpuArgs {
     json: bool,
 }
 
+/// `artmesh sample`'s arguments.
 #[derive(clap::Args)]
 pub struct SampleArgs {
     /// Folder to create; existing files are never overwritten.

@@ -7,6 +7,7 @@ use artmesh::fit::photometric::{self, PhotometricConfig, SceneSpec};
 
 use crate::args::{context, to_json};
 
+/// `artmesh learn`'s arguments.
 #[derive(clap::Args)]
 pub struct LearnArgs {
     /// Category (as for `synth`).

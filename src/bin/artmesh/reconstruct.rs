@@ -10,6 +10,7 @@ use artmesh::fit::reconstruct::{Progress, ReconstructionConfig};
 use crate::args::{context, reconstruction_config, to_json};
 use crate::{capture, progress};
 
+/// `artmesh reconstruct`'s arguments.
 #[derive(clap::Args)]
 pub struct ReconstructArgs {
     /// Dataset folder (ArtGS / MPArt-90 / PARIS layout, with depth and semantic maps).

@@ -13,6 +13,7 @@ use serde::Serialize;
 use crate::args::{CaptureArgs, context};
 use crate::capture::{dataset, fresh_folder, write_object};
 
+/// `artmesh suite`'s arguments.
 #[derive(clap::Args)]
 pub struct SuiteArgs {
     /// New folder to write.

@@ -9,6 +9,7 @@ use artmesh::synth::{Category, SynthParams, generate};
 use crate::args::{CaptureArgs, context};
 use crate::capture;
 
+/// `artmesh synth`'s arguments.
 #[derive(clap::Args)]
 pub struct SynthArgs {
     /// Category: a name of the paper's 16 (Box, Eyeglasses, Faucet, FoldingChair, Knife, Laptop,
@@ -32,6 +33,7 @@ pub struct SynthArgs {
     capture: CaptureArgs,
 }
 
+/// `artmesh render`'s arguments.
 #[derive(clap::Args)]
 pub struct RenderArgs {
     /// The URDF; relative mesh paths resolve against its folder, package:// paths against the

@@ -9,6 +9,7 @@ use serde::Serialize;
 
 use crate::args::{context, to_json};
 
+/// `artmesh bench capture`'s arguments.
 #[derive(clap::Args)]
 pub struct CaptureBenchArgs {
     /// Square image sizes to time.

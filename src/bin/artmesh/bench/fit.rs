@@ -20,6 +20,7 @@ use crate::args::{SuiteObjects, context, fit_config, to_json};
 use crate::capture::fresh_file;
 use crate::suite::CaptureSettings;
 
+/// `artmesh bench fit`'s arguments.
 #[derive(clap::Args)]
 pub struct FitBenchArgs {
     /// A folder written by `artmesh suite`: its datasets are fitted as they are.

@@ -16,6 +16,7 @@ use serde::Serialize;
 use super::source::SuiteSource;
 use crate::args::{context, to_json};
 
+/// `artmesh bench joints`'s arguments.
 #[derive(clap::Args)]
 pub struct JointsArgs {
     /// A folder written by `artmesh suite`.

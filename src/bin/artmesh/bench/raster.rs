@@ -13,6 +13,7 @@ use serde::Serialize;
 
 use crate::args::{context, to_json};
 
+/// `artmesh bench raster`'s arguments.
 #[derive(clap::Args)]
 pub struct RasterArgs {
     /// Cases as SIZExFACES (square image side, target face count).

@@ -14,6 +14,7 @@ use super::source::capture_entry;
 use crate::args::{SuiteObjects, context, reconstruction_config, to_json};
 use crate::suite::CaptureSettings;
 
+/// `artmesh bench reconstruct`'s arguments.
 #[derive(clap::Args)]
 pub struct ReconstructBenchArgs {
     #[command(flatten)]

@@ -8,6 +8,7 @@ use serde::Serialize;
 
 use crate::args::{context, to_json};
 
+/// `artmesh bench sort`'s arguments.
 #[derive(clap::Args)]
 pub struct SortArgs {
     /// Key counts to time.

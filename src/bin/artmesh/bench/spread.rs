@@ -17,6 +17,7 @@ use serde::Serialize;
 
 use crate::args::{context, fit_config, to_json};
 
+/// `artmesh bench spread`'s arguments.
 #[derive(clap::Args)]
 pub struct SpreadArgs {
     /// Dataset folder.
