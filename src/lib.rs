@@ -20,8 +20,5 @@ pub mod render;
 pub mod rng;
 pub mod synth;
 
-#[cfg(not(target_arch = "wasm32"))]
-pub mod bench;
-
 #[cfg(target_arch = "wasm32")]
 pub mod web;

@@ -211,7 +211,7 @@ fn measured_capture(spec: &mut artmesh::render::RenderSpec) {
 fn measured_joints_survive_noisy_and_missing_depth() {
     let ctx = common::context();
     let noisy = |d: &mut artmesh::data::Dataset| {
-        let degrade = artmesh::bench::DepthDegradation {
+        let degrade = artmesh::data::degrade::DepthDegradation {
             noise_mm: 4.0,
             drop_every: 2,
         };

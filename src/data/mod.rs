@@ -18,6 +18,7 @@
 mod archive;
 mod camera;
 mod dataset;
+pub mod degrade;
 mod error;
 pub mod fixture;
 #[cfg(not(target_arch = "wasm32"))]

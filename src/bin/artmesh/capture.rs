@@ -1,18 +1,14 @@
-//! `artmesh synth`, `render` and `suite`: objects in, two-state datasets out, written as they are rendered.
+//! What `artmesh synth`, `render` and `suite` share: objects in, two-state datasets out, written as
+//! they are rendered; fresh folders and files only.
 
 use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
 
-use artmesh::data::{self, FileSet, PngPixels, encode_png};
+use artmesh::data::{self, FileSet};
 use artmesh::export::write_urdf;
 use artmesh::gpu::GpuContext;
 use artmesh::object::ArticulatedObject;
-use artmesh::render::{
-    RenderProgress, RenderSpec, RenderedDataset, SheetEntry, contact_sheet, render_dataset,
-};
-use artmesh::synth::{SuiteEntry, SuiteKind, generate};
-
-use super::CaptureArgs;
+use artmesh::render::{RenderProgress, RenderSpec, RenderedDataset, render_dataset};
 
 /// Refuses an existing non-empty folder: generated files never mix with (or overwrite) the user's.
 pub fn fresh_folder(out: &Path) -> Result<(), String> {
@@ -107,113 +103,4 @@ fn progress_printer(name: &str) -> impl FnMut(RenderProgress) + '_ {
             }
         }
     }
-}
-
-/// The suite manifest: what was generated and how it was captured.
-#[derive(serde::Serialize)]
-struct SuiteManifest<'a> {
-    suite: &'static str,
-    generator: String,
-    capture: CaptureJson,
-    objects: Vec<ManifestEntry<'a>>,
-}
-
-#[derive(serde::Serialize)]
-struct CaptureJson {
-    width: u32,
-    height: u32,
-    train_views: usize,
-    test_views: usize,
-    fov_x: f32,
-    start_range: (f32, f32),
-    end_range: (f32, f32),
-    upper_hemisphere: bool,
-}
-
-#[derive(serde::Serialize)]
-struct ManifestEntry<'a> {
-    id: String,
-    #[serde(flatten)]
-    entry: &'a SuiteEntry,
-    name: String,
-    parts: usize,
-}
-
-/// `artmesh suite`: every planned object into `out/<id>/` (dataset + `object/`), then `suite.json` and
-/// `contact-sheet.png`.
-pub fn suite(
-    ctx: &GpuContext,
-    out: &Path,
-    kind: SuiteKind,
-    capture: &CaptureArgs,
-) -> Result<(), String> {
-    fresh_folder(out)?;
-    let quick = kind == SuiteKind::Quick;
-    let plan = kind.plan();
-    let mut objects = Vec::with_capacity(plan.len());
-    let mut manifest = Vec::with_capacity(plan.len());
-    let spec0 = capture.spec(quick, 0);
-    for entry in &plan {
-        let object = generate(&entry.params()).map_err(|e| format!("{}: {e}", entry.id()))?;
-        let folder = out.join(entry.id());
-        write_object(&object, &folder.join("object"))?;
-        let rendered = dataset(ctx, &object, &capture.spec(quick, entry.seed), &folder)?;
-        eprintln!(
-            "[{}/{}] {} ({} parts, {} frames)",
-            manifest.len() + 1,
-            plan.len(),
-            entry.id(),
-            rendered.num_parts,
-            rendered.frames
-        );
-        manifest.push(ManifestEntry {
-            id: entry.id(),
-            entry,
-            name: object.name.clone(),
-            parts: rendered.num_parts,
-        });
-        objects.push((object, rendered.truth.states));
-    }
-    let json = SuiteManifest {
-        suite: kind.name(),
-        generator: format!("artmesh {}", env!("CARGO_PKG_VERSION")),
-        capture: CaptureJson {
-            width: spec0.width,
-            height: spec0.height,
-            train_views: spec0.train_views,
-            test_views: spec0.test_views,
-            fov_x: spec0.fov_x,
-            start_range: spec0.start_range,
-            end_range: spec0.end_range,
-            upper_hemisphere: spec0.upper_hemisphere,
-        },
-        objects: manifest,
-    };
-    let mut files = FileSet::new();
-    let text = serde_json::to_vec_pretty(&json).map_err(|e| e.to_string())?;
-    files.insert("suite.json".into(), text);
-    let entries: Vec<SheetEntry> = objects
-        .iter()
-        .map(|(object, states)| SheetEntry {
-            object,
-            states: states.clone(),
-        })
-        .collect();
-    let sheet =
-        pollster::block_on(contact_sheet(ctx, &entries, 128, 8)).map_err(|e| e.to_string())?;
-    let png = encode_png(
-        "contact-sheet.png",
-        sheet.width,
-        sheet.height,
-        PngPixels::Rgba8(&sheet.pixels),
-    )
-    .map_err(|e| e.to_string())?;
-    files.insert("contact-sheet.png".into(), png);
-    data::write_dir(&files, out).map_err(|e| e.to_string())?;
-    eprintln!(
-        "wrote {} objects, suite.json and contact-sheet.png to {}",
-        plan.len(),
-        out.display()
-    );
-    Ok(())
 }

@@ -1,0 +1,113 @@
+//! What several commands share: capture options, the suite objects a benchmark fits, the
+//! preset budgets, and the GPU context and JSON output every command uses.
+
+use artmesh::fit::object::FitConfig;
+use artmesh::fit::reconstruct::{Preset, ReconstructionConfig, RemeshMode};
+use artmesh::gpu::GpuContext;
+use artmesh::render::RenderSpec;
+
+/// Which suite objects a benchmark fits, and how they are captured.
+#[derive(clap::Args)]
+pub struct SuiteObjects {
+    /// Preset: tiny, fast or paper.
+    #[arg(long, default_value = "fast", value_parser = ["tiny", "fast", "paper"])]
+    pub preset: String,
+    /// Only objects whose id contains one of these (e.g. laptop,oven); default all.
+    #[arg(long, value_delimiter = ',')]
+    pub objects: Vec<String>,
+    /// Square capture size (the quick suite's is 64).
+    #[arg(long, default_value_t = 64)]
+    pub size: u32,
+    /// Training views per state (the quick suite's is 6).
+    #[arg(long, default_value_t = 6)]
+    pub views: usize,
+}
+
+/// How objects are captured (defaults: the paper's Articulate-100 setting).
+#[derive(clap::Args)]
+pub struct CaptureArgs {
+    /// Image width in pixels [default: 800; 64 with --quick].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(8..=8192))]
+    width: Option<u32>,
+    /// Image height in pixels [default: 800; 64 with --quick].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(8..=8192))]
+    height: Option<u32>,
+    /// Train views per state [default: 100; 6 with --quick].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
+    train_views: Option<u32>,
+    /// Test views per state [default: 20; 2 with --quick].
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=10_000))]
+    test_views: Option<u32>,
+    /// Horizontal field of view in degrees.
+    #[arg(long, default_value_t = 39.6)]
+    fov: f32,
+    /// Start state: interval of each joint's normalised range to draw from.
+    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [0.6f32, 0.8])]
+    start_range: Vec<f32>,
+    /// End state: interval of each joint's normalised range to draw from.
+    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [0.2f32, 0.4])]
+    end_range: Vec<f32>,
+    /// Cameras on the whole sphere instead of the upper hemisphere.
+    #[arg(long)]
+    sphere: bool,
+}
+
+impl CaptureArgs {
+    /// The capture these options ask for (quick: the quick suite's defaults), drawn with `seed`.
+    pub fn spec(&self, quick: bool, seed: u64) -> RenderSpec {
+        let (size, train, test) = if quick { (64, 6, 2) } else { (800, 100, 20) };
+        let pair = |v: &[f32]| {
+            (
+                v.first().copied().unwrap_or(0.0),
+                v.get(1).copied().unwrap_or(0.0),
+            )
+        };
+        RenderSpec {
+            width: self.width.unwrap_or(size),
+            height: self.height.unwrap_or(size),
+            train_views: self.train_views.map_or(train, |v| v as usize),
+            test_views: self.test_views.map_or(test, |v| v as usize),
+            fov_x: self.fov.to_radians(),
+            start_range: pair(&self.start_range),
+            end_range: pair(&self.end_range),
+            upper_hemisphere: !self.sphere,
+            seed,
+        }
+    }
+}
+
+/// Overrides of a preset's budget shared by `fit` and `demo` (flattened into both): the place
+/// for options such as the working size, views per state or iteration counts. None yet.
+#[derive(clap::Args)]
+pub struct BudgetArgs {}
+
+impl BudgetArgs {
+    /// Both phases' settings of the named preset, with these overrides applied.
+    pub fn fit_config(&self, preset: &str) -> Result<FitConfig, String> {
+        fit_config(preset)
+    }
+}
+
+/// Both phases' settings of the named preset.
+pub fn fit_config(preset: &str) -> Result<FitConfig, String> {
+    Ok(FitConfig::preset(Preset::parse(preset)?))
+}
+
+/// The named preset with the named remeshing mode (`part-aware` or `global`).
+pub fn reconstruction_config(preset: &str, remesh: &str) -> Result<ReconstructionConfig, String> {
+    let mut config = ReconstructionConfig::preset(Preset::parse(preset)?);
+    if remesh == "global" {
+        config.remesh = RemeshMode::Global;
+    }
+    Ok(config)
+}
+
+/// The GPU every command runs on.
+pub fn context() -> Result<GpuContext, String> {
+    pollster::block_on(GpuContext::new()).map_err(|e| e.to_string())
+}
+
+/// `value` as pretty JSON (what commands print on stdout).
+pub fn to_json<T: serde::Serialize>(value: &T) -> Result<String, String> {
+    serde_json::to_string_pretty(value).map_err(|e| e.to_string())
+}
