@@ -523,7 +523,7 @@ pub struct FitObject {
     pub reconstruct_s: f64,
     pub articulate_s: f64,
     pub metrics: crate::eval::ObjectMetrics,
-    pub joints: Vec<crate::fit::object::JointRecord>,
+    pub joints: Vec<crate::export::JointRecord>,
     pub warnings: Vec<String>,
 }
 
@@ -787,7 +787,7 @@ pub fn fit(
         degrade.apply(&mut dataset, 17);
         let category = object.category.clone();
         let score = |fit: &ObjectFit| -> Result<crate::eval::ObjectMetrics, String> {
-            fit.evaluate(&dataset, &id, &category, &options)
+            crate::eval::evaluate_fit(fit, &dataset, &id, &category, &options)
                 .ok_or_else(|| named("the captured object has no ground-truth joints".into()))?
                 .map_err(|e| named(e.to_string()))
         };
@@ -822,7 +822,7 @@ pub fn fit(
             reconstruct_s,
             articulate_s: seconds - reconstruct_s,
             metrics: metrics.clone(),
-            joints: fit.joint_records(),
+            joints: crate::export::joint_records(&fit),
             warnings: fit.articulation.warnings.clone(),
         };
         log(&done);
@@ -937,7 +937,7 @@ pub struct SpreadRun {
     /// first numbers where two fits part ways.
     pub psnr_optimised: Vec<f64>,
     pub remeshed_faces: Vec<usize>,
-    pub joints: Vec<crate::fit::object::JointRecord>,
+    pub joints: Vec<crate::export::JointRecord>,
     /// Against the dataset's ground truth (`None` without one): the fitted joints' errors, and
     /// those of the registration seeds the refinement started from (`None` when a part has no
     /// seed), matched as `artmesh eval` matches them. Shows whether the fits scatter around the
@@ -1057,7 +1057,7 @@ pub fn spread(
             seconds: start.elapsed().as_secs_f64(),
             psnr_optimised: states.iter().map(|s| s.psnr_optimised).collect(),
             remeshed_faces: states.iter().map(|s| s.remesh.faces_built).collect(),
-            joints: fit.joint_records(),
+            joints: crate::export::joint_records(&fit),
             gt_errors: against_gt(&fitted),
             seed_gt_errors: seeds_gt,
         };

@@ -11,10 +11,11 @@ fn motion_kernels_match_the_cpu() {
 }
 
 use artmesh::data::{JointKind, Split, State};
-use artmesh::eval::EvalOptions;
+use artmesh::eval::{EvalOptions, evaluate_fit};
 use artmesh::fit::articulate::GeometryUse;
-use artmesh::fit::object::{FitConfig, tiny_fit, tiny_fit_with};
+use artmesh::fit::object::FitConfig;
 use artmesh::fit::reconstruct::Preset;
+use artmesh::fixtures::object::{tiny_fit, tiny_fit_with};
 use artmesh::synth::Category;
 
 fn no_edit(_: &mut artmesh::data::Dataset) {}
@@ -55,10 +56,15 @@ fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
             JointKind::Revolute => assert!(rot <= trans),
             JointKind::Prismatic => assert!(trans < rot),
         }
-        let metrics = fit
-            .evaluate(&dataset, "tiny", category.name(), &EvalOptions::default())
-            .unwrap()
-            .unwrap();
+        let metrics = evaluate_fit(
+            &fit,
+            &dataset,
+            "tiny",
+            category.name(),
+            &EvalOptions::default(),
+        )
+        .unwrap()
+        .unwrap();
         println!("{category:?}: {}", serde_json::to_string(&metrics).unwrap());
         assert_eq!(metrics.type_accuracy, Some(1.0));
         // 32² views: a pixel is about 1 cm at the object; the axis is still within a few degrees.
@@ -171,15 +177,15 @@ fn measured_joints_get_every_type_right_on_a_two_and_a_six_part_object() {
             &no_edit,
         ))
         .unwrap();
-        let metrics = fit
-            .evaluate(
-                &dataset,
-                "measured",
-                category.name(),
-                &EvalOptions::default(),
-            )
-            .unwrap()
-            .unwrap();
+        let metrics = evaluate_fit(
+            &fit,
+            &dataset,
+            "measured",
+            category.name(),
+            &EvalOptions::default(),
+        )
+        .unwrap()
+        .unwrap();
         println!("{category:?}: {}", serde_json::to_string(&metrics).unwrap());
         for j in &fit.articulation.joints {
             println!(
@@ -226,15 +232,15 @@ fn measured_joints_survive_noisy_and_missing_depth() {
         &noisy,
     ))
     .unwrap();
-    let metrics = fit
-        .evaluate(
-            &dataset,
-            "noisy",
-            "StorageFurniture",
-            &EvalOptions::default(),
-        )
-        .unwrap()
-        .unwrap();
+    let metrics = evaluate_fit(
+        &fit,
+        &dataset,
+        "noisy",
+        "StorageFurniture",
+        &EvalOptions::default(),
+    )
+    .unwrap()
+    .unwrap();
     println!("noisy: {}", serde_json::to_string(&metrics).unwrap());
     for j in &fit.articulation.joints {
         println!(
