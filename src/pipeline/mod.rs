@@ -14,8 +14,6 @@ use crate::fit::object::{FitConfig, ObjectFit, fit_object};
 use crate::fit::observer::Observer;
 use crate::gpu::{GpuContext, GpuError, now_seconds};
 
-pub use demo::{capture_demo, demo_object};
-
 /// The category label of a user's dataset (the demo's objects carry their synthetic category).
 pub const UNKNOWN_CATEGORY: &str = "unknown";
 

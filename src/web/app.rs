@@ -153,10 +153,10 @@ impl WebDataset {
         let category = Category::parse(&category).map_err(|e| JsError::new(&e))?;
         let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
         let object =
-            pipeline::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
+            pipeline::demo::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
         let ctx = context().await?;
         let spec = config.demo_capture(seed.into());
-        let input = pipeline::capture_demo(&ctx, &object, category, &spec, &mut |p| {
+        let input = pipeline::demo::capture_demo(&ctx, &object, category, &spec, &mut |p| {
             let ev = js_object(&[
                 ("done", number(p.done as u32)),
                 ("total", number(p.total as u32)),
