@@ -15,15 +15,20 @@ use artmesh::eval::{EvalOptions, evaluate_fit};
 use artmesh::fit::articulate::GeometryUse;
 use artmesh::fit::object::FitConfig;
 use artmesh::fit::reconstruct::Preset;
-use artmesh::fixtures::object::{tiny_fit, tiny_fit_with};
+use artmesh::fixtures::object::tiny_fit;
 use artmesh::synth::Category;
 
 fn no_edit(_: &mut artmesh::data::Dataset) {}
 fn no_spec_edit(_: &mut artmesh::render::RenderSpec) {}
 
+/// The tiny preset.
+fn tiny() -> FitConfig {
+    FitConfig::preset(Preset::Tiny)
+}
+
 /// The tiny preset without the measured joints: the paper's photometric stages alone.
 fn photometric_only() -> FitConfig {
-    let mut config = FitConfig::preset(Preset::Tiny);
+    let mut config = tiny();
     config.articulation.geometry = GeometryUse::Off;
     config
 }
@@ -35,7 +40,7 @@ fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
         (Category::Laptop, 1005, JointKind::Revolute),
         (Category::Pen, 1007, JointKind::Prismatic),
     ] {
-        let (dataset, fit) = pollster::block_on(tiny_fit_with(
+        let (dataset, fit) = pollster::block_on(tiny_fit(
             &ctx,
             category,
             1,
@@ -86,6 +91,7 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
             spec.end_range = (0.5, 0.5);
         },
         &no_edit,
+        &tiny(),
     ))
     .unwrap();
     println!("still: {:?}", fit.articulation.warnings);
@@ -117,6 +123,7 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
                 }
             }
         },
+        &tiny(),
     ))
     .unwrap();
     println!("invisible: {:?}", fit.articulation.warnings);
@@ -148,6 +155,7 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
                 }
             }
         },
+        &tiny(),
     ))
     .unwrap_err();
     println!("no depth: {err}");
@@ -175,6 +183,7 @@ fn measured_joints_get_every_type_right_on_a_two_and_a_six_part_object() {
                 spec.test_views = 4;
             },
             &no_edit,
+            &tiny(),
         ))
         .unwrap();
         let metrics = evaluate_fit(
@@ -230,6 +239,7 @@ fn measured_joints_survive_noisy_and_missing_depth() {
         4,
         &measured_capture,
         &noisy,
+        &tiny(),
     ))
     .unwrap();
     let metrics = evaluate_fit(
@@ -285,6 +295,7 @@ fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
                 }
             }
         },
+        &tiny(),
     ))
     .unwrap_err();
     println!("unseen: {err}");
@@ -303,6 +314,7 @@ fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
             spec.test_views = 0;
         },
         &no_edit,
+        &tiny(),
     ))
     .unwrap();
     assert!(
