@@ -11,18 +11,24 @@ fn motion_kernels_match_the_cpu() {
 }
 
 use artmesh::data::{JointKind, Split, State};
-use artmesh::eval::EvalOptions;
+use artmesh::eval::{EvalOptions, evaluate_fit};
 use artmesh::fit::articulate::GeometryUse;
-use artmesh::fit::object::{FitConfig, tiny_fit, tiny_fit_with};
+use artmesh::fit::object::FitConfig;
 use artmesh::fit::reconstruct::Preset;
+use artmesh::fixtures::object::tiny_fit;
 use artmesh::synth::Category;
 
 fn no_edit(_: &mut artmesh::data::Dataset) {}
 fn no_spec_edit(_: &mut artmesh::render::RenderSpec) {}
 
+/// The tiny preset.
+fn tiny() -> FitConfig {
+    FitConfig::preset(Preset::Tiny)
+}
+
 /// The tiny preset without the measured joints: the paper's photometric stages alone.
 fn photometric_only() -> FitConfig {
-    let mut config = FitConfig::preset(Preset::Tiny);
+    let mut config = tiny();
     config.articulation.geometry = GeometryUse::Off;
     config
 }
@@ -34,7 +40,7 @@ fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
         (Category::Laptop, 1005, JointKind::Revolute),
         (Category::Pen, 1007, JointKind::Prismatic),
     ] {
-        let (dataset, fit) = pollster::block_on(tiny_fit_with(
+        let (dataset, fit) = pollster::block_on(tiny_fit(
             &ctx,
             category,
             1,
@@ -55,10 +61,15 @@ fn the_bake_off_picks_revolute_for_a_laptop_lid_and_prismatic_for_a_pen_cap() {
             JointKind::Revolute => assert!(rot <= trans),
             JointKind::Prismatic => assert!(trans < rot),
         }
-        let metrics = fit
-            .evaluate(&dataset, "tiny", category.name(), &EvalOptions::default())
-            .unwrap()
-            .unwrap();
+        let metrics = evaluate_fit(
+            &fit,
+            &dataset,
+            "tiny",
+            category.name(),
+            &EvalOptions::default(),
+        )
+        .unwrap()
+        .unwrap();
         println!("{category:?}: {}", serde_json::to_string(&metrics).unwrap());
         assert_eq!(metrics.type_accuracy, Some(1.0));
         // 32² views: a pixel is about 1 cm at the object; the axis is still within a few degrees.
@@ -80,6 +91,7 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
             spec.end_range = (0.5, 0.5);
         },
         &no_edit,
+        &tiny(),
     ))
     .unwrap();
     println!("still: {:?}", fit.articulation.warnings);
@@ -111,6 +123,7 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
                 }
             }
         },
+        &tiny(),
     ))
     .unwrap();
     println!("invisible: {:?}", fit.articulation.warnings);
@@ -142,6 +155,7 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
                 }
             }
         },
+        &tiny(),
     ))
     .unwrap_err();
     println!("no depth: {err}");
@@ -169,17 +183,18 @@ fn measured_joints_get_every_type_right_on_a_two_and_a_six_part_object() {
                 spec.test_views = 4;
             },
             &no_edit,
+            &tiny(),
         ))
         .unwrap();
-        let metrics = fit
-            .evaluate(
-                &dataset,
-                "measured",
-                category.name(),
-                &EvalOptions::default(),
-            )
-            .unwrap()
-            .unwrap();
+        let metrics = evaluate_fit(
+            &fit,
+            &dataset,
+            "measured",
+            category.name(),
+            &EvalOptions::default(),
+        )
+        .unwrap()
+        .unwrap();
         println!("{category:?}: {}", serde_json::to_string(&metrics).unwrap());
         for j in &fit.articulation.joints {
             println!(
@@ -224,17 +239,18 @@ fn measured_joints_survive_noisy_and_missing_depth() {
         4,
         &measured_capture,
         &noisy,
+        &tiny(),
     ))
     .unwrap();
-    let metrics = fit
-        .evaluate(
-            &dataset,
-            "noisy",
-            "StorageFurniture",
-            &EvalOptions::default(),
-        )
-        .unwrap()
-        .unwrap();
+    let metrics = evaluate_fit(
+        &fit,
+        &dataset,
+        "noisy",
+        "StorageFurniture",
+        &EvalOptions::default(),
+    )
+    .unwrap()
+    .unwrap();
     println!("noisy: {}", serde_json::to_string(&metrics).unwrap());
     for j in &fit.articulation.joints {
         println!(
@@ -279,6 +295,7 @@ fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
                 }
             }
         },
+        &tiny(),
     ))
     .unwrap_err();
     println!("unseen: {err}");
@@ -297,6 +314,7 @@ fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
             spec.test_views = 0;
         },
         &no_edit,
+        &tiny(),
     ))
     .unwrap();
     assert!(

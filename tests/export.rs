@@ -274,18 +274,19 @@ fn truth_twins_export_valid_glbs_and_urdfs_the_simulators_follow() {
 #[test]
 fn fitted_twin_exports_follow_the_fitted_motions_in_the_simulators() {
     let ctx = common::context();
-    let (_, fit) = block_on(artmesh::fit::object::tiny_fit(
+    let (_, fit) = block_on(artmesh::fixtures::object::tiny_fit(
         &ctx,
         Category::StorageFurniture,
         2,
         4,
         &|_| {},
         &|_| {},
+        &artmesh::fit::object::FitConfig::preset(artmesh::fit::reconstruct::Preset::Tiny),
     ))
     .unwrap();
     let twin = Twin::from_fit(&fit, "cabinet").unwrap();
     assert!(twin.parts.iter().all(|p| p.colors.is_some()));
-    let records = fit.joint_records();
+    let records = artmesh::export::joint_records(&fit);
     let json = serde_json::to_vec(&records).unwrap();
     let object = twin.object();
     let end = artmesh::export::end_configuration(&object, &json, "joints.json").unwrap();

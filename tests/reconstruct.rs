@@ -3,8 +3,9 @@
 //! ablation builds faces across parts and the report counts them.
 #![cfg(not(target_arch = "wasm32"))]
 
-use artmesh::eval::mesh_quality::{reconstruction_failures, tiny_reconstruction};
+use artmesh::eval::mesh_quality::reconstruction_failures;
 use artmesh::fit::reconstruct::RemeshMode;
+use artmesh::fixtures::object::tiny_reconstruction;
 use artmesh::mesh::topology::cross_part_faces;
 
 mod common;

@@ -237,8 +237,9 @@ async fn a_short_photometric_fit_learns_and_repeats_in_the_browser() {
 
 #[wasm_bindgen_test]
 async fn a_tiny_reconstruction_runs_in_the_browser() {
-    use artmesh::eval::mesh_quality::{reconstruction_failures, tiny_reconstruction};
+    use artmesh::eval::mesh_quality::reconstruction_failures;
     use artmesh::fit::reconstruct::RemeshMode;
+    use artmesh::fixtures::object::tiny_reconstruction;
     let ctx = context().await;
     let (reconstruction, report) = tiny_reconstruction(&ctx, RemeshMode::PartAware)
         .await
@@ -283,8 +284,8 @@ async fn motion_kernels_match_the_cpu_in_the_browser() {
 #[wasm_bindgen_test]
 async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
     use artmesh::data::JointKind;
-    use artmesh::eval::EvalOptions;
-    use artmesh::fit::object::tiny_fit;
+    use artmesh::eval::{EvalOptions, evaluate_fit};
+    use artmesh::fixtures::object::tiny_fit;
     let ctx = context().await;
     let (dataset, fit) = tiny_fit(
         &ctx,
@@ -293,11 +294,11 @@ async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
         1005,
         &|_| {},
         &|_| {},
+        &artmesh::fit::object::FitConfig::preset(artmesh::fit::reconstruct::Preset::Tiny),
     )
     .await
     .unwrap();
-    let metrics = fit
-        .evaluate(&dataset, "tiny", "Laptop", &EvalOptions::default())
+    let metrics = evaluate_fit(&fit, &dataset, "tiny", "Laptop", &EvalOptions::default())
         .unwrap()
         .unwrap();
     console_log!(
@@ -314,7 +315,7 @@ async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
     // The downloads are made in wasm too: the GLB reads back with the base and its hinged lid, the
     // zip holds the URDF, its meshes, joints.json and the GLB.
     let twin = artmesh::export::Twin::from_fit(&fit, "laptop").unwrap();
-    let joints = serde_json::to_vec(&fit.joint_records()).unwrap();
+    let joints = serde_json::to_vec(&artmesh::export::joint_records(&fit)).unwrap();
     let files =
         artmesh::export::export_twin(&twin.object(), &twin.end_configuration(), &joints).unwrap();
     let doc = gltf::Gltf::from_slice(&files.glb).unwrap().document;

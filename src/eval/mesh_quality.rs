@@ -147,46 +147,6 @@ pub fn reconstruction_report(
     }
 }
 
-/// The `tiny` reconstruction both the native and the browser tests run: a procedural laptop
-/// (base + lid, 2 parts) captured at 32² from 4 views per state, reconstructed with `remesh`.
-pub async fn tiny_reconstruction(
-    ctx: &crate::gpu::GpuContext,
-    remesh: crate::fit::reconstruct::RemeshMode,
-) -> Result<(Reconstruction, ReconstructionReport), String> {
-    use crate::fit::observer::Unobserved;
-    use crate::fit::reconstruct::{Preset, ReconstructionConfig, reconstruct};
-    let object = crate::synth::generate(&crate::synth::SynthParams {
-        category: crate::synth::Category::Laptop,
-        movable_parts: Some(1),
-        seed: 1005,
-    })?;
-    let spec = crate::render::RenderSpec {
-        width: 32,
-        height: 32,
-        train_views: 4,
-        test_views: 0,
-        seed: 1005,
-        ..crate::render::RenderSpec::default()
-    };
-    let dataset = crate::render::capture_dataset(ctx, &object, &spec, &mut |_| {}).await?;
-    let config = ReconstructionConfig {
-        remesh,
-        ..ReconstructionConfig::preset(Preset::Tiny)
-    };
-    let reconstruction = reconstruct(ctx, &dataset, &config, &mut Unobserved)
-        .await
-        .map_err(|e| e.to_string())?;
-    let report = reconstruction_report(
-        &reconstruction,
-        &dataset.gt_meshes,
-        &ChamferOptions {
-            samples: 2_000,
-            ..ChamferOptions::default()
-        },
-    );
-    Ok((reconstruction, report))
-}
-
 /// What a part-aware reconstruction must satisfy, as a list of failures (empty = pass): no
 /// cross-part face, every part a non-empty mesh with no more pieces than its ground truth (or
 /// one), no non-manifold edge, a Chamfer distance below `max_cd_mm` to the ground truth, and a

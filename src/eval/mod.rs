@@ -7,7 +7,8 @@
 //! - [`chamfer`]: area-weighted surface sampling, k-d tree nearest neighbours, `cd_peer` and `cd_mm`.
 //! - [`mesh_quality`]: per-part components, boundary / non-manifold / cross-part counts and Chamfer of a
 //!   reconstruction ([`reconstruction_report`]).
-//! - [`report`]: [`ObjectMetrics`] per object ([`evaluate_object`]), serialisable to JSON.
+//! - [`report`]: [`ObjectMetrics`] per object ([`evaluate_object`], or [`evaluate_fit`] for a fit
+//!   against its dataset's ground truth), serialisable to JSON.
 //! - [`tables`]: part-count buckets (2 / 3 / 4-5 / 6+ / All, the paper's Table 1) and per-category columns (the
 //!   appendix table), as structs and Markdown.
 //!
@@ -32,7 +33,7 @@ pub use joints::{
     match_joints, match_joints_using, motion_error,
 };
 pub use mesh_quality::{PartQuality, ReconstructionReport, StateQuality, reconstruction_report};
-pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_object};
+pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_fit, evaluate_object};
 pub use tables::{BenchmarkTable, ColumnSummary, PartBucket};
 
 /// Why an object could not be evaluated.

@@ -8,7 +8,8 @@
 use super::EvalError;
 use super::chamfer::{ChamferDistance, ChamferOptions, MeshFault, chamfer_meshes};
 use super::joints::{JointPairMetrics, match_joints};
-use crate::data::{GtJoint, GtMeshes, JointKind, TriMesh};
+use crate::data::{Dataset, GtJoint, GtMeshes, JointKind, State, TriMesh};
+use crate::fit::object::ObjectFit;
 
 /// Settings of [`evaluate_object`].
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize, serde::Deserialize)]
@@ -187,4 +188,29 @@ pub fn evaluate_object(
         unmatched_gt: matching.unmatched_gt,
         type_errors: matching.type_errors,
     })
+}
+
+/// Scores `fit` against `dataset`'s ground truth (joints, and start-state meshes when both
+/// sides have them) as object `id` of `category`; `None` without GT joints.
+pub fn evaluate_fit(
+    fit: &ObjectFit,
+    dataset: &Dataset,
+    id: &str,
+    category: &str,
+    options: &EvalOptions,
+) -> Option<Result<ObjectMetrics, EvalError>> {
+    let gt_joints = dataset.gt_joints.as_ref()?;
+    let predicted = fit.as_ground_truth();
+    let state = State::Start.index();
+    let meshes = predicted.meshes[state]
+        .as_ref()
+        .zip(dataset.gt_meshes[state].as_ref());
+    Some(evaluate_object(
+        id,
+        category,
+        &fit.articulation.gt_joints(),
+        gt_joints,
+        meshes,
+        options,
+    ))
 }

@@ -3,10 +3,13 @@
 
 use serde::Serialize;
 
+use super::joints::{JointRecord, joint_records};
 use super::{JOINTS_FILE, Twin, export_twin};
 use crate::data::{Dataset, FileSet};
-use crate::eval::{ChamferOptions, EvalOptions, ObjectMetrics, reconstruction_report};
-use crate::fit::object::{FitConfig, JointRecord, ObjectFit};
+use crate::eval::{
+    ChamferOptions, EvalOptions, ObjectMetrics, evaluate_fit, reconstruction_report,
+};
+use crate::fit::object::{FitConfig, ObjectFit};
 
 /// The fit report's path in a fit folder.
 pub const REPORT_FILE: &str = "report.json";
@@ -47,11 +50,10 @@ impl FitFolder {
             &dataset.gt_meshes,
             &ChamferOptions::default(),
         );
-        let metrics = fit
-            .evaluate(dataset, id, category, &EvalOptions::default())
+        let metrics = evaluate_fit(fit, dataset, id, category, &EvalOptions::default())
             .transpose()
             .map_err(|e| format!("{id}: scoring against the ground truth: {e}"))?;
-        let joints = fit.joint_records();
+        let joints = joint_records(fit);
         let report = serde_json::json!({
             "id": id,
             "seconds": seconds,

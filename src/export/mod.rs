@@ -6,6 +6,7 @@
 //!   volume at [`inertia::DENSITY`]), limits on every joint.
 //! - [`glb`]: binary glTF with the link tree as nodes, vertex colours, a start → end animation and
 //!   the joints in `extras`.
+//! - [`joints`]: `joints.json`, the fitted joints as records with their names, limits and evidence.
 //! - [`archive`]: everything as one zip whose paths cannot leave the folder it is unpacked in.
 //! - [`folder`]: all of a fit's files (report, joints, part meshes, exports) for the CLI's fit
 //!   folder and the page's downloads.
@@ -16,12 +17,14 @@ pub mod archive;
 pub mod folder;
 pub mod glb;
 pub mod inertia;
+pub mod joints;
 pub mod twin;
 pub mod urdf;
 
 pub use archive::write_zip;
 pub use folder::{FitFolder, REPORT_FILE};
 pub use glb::write_glb;
+pub use joints::{GeometryRecord, JointRecord, joint_records};
 pub use twin::{Twin, TwinPart};
 pub use urdf::write_urdf;
 

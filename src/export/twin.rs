@@ -18,6 +18,7 @@ use crate::data::{GtJoint, GtMeshes, JointKind as GtKind, State, TriMesh};
 use crate::fit::object::ObjectFit;
 use crate::object::{
     ArticulatedObject, Geometry, Joint, JointKind, Limit, Link, Material, RenderMesh, Visual,
+    part_joint,
 };
 
 /// Name of the root link (part 0).
@@ -30,11 +31,6 @@ pub const JOINT_VELOCITY: f32 = 1.0;
 /// Link name of movable part `k` (1 ..= K).
 pub fn part_link(k: usize) -> String {
     format!("part_{k}")
-}
-
-/// Name of the joint that moves part `k`.
-pub fn part_joint(k: usize) -> String {
-    format!("joint_{k}")
 }
 
 /// One part of a twin.

@@ -1,9 +1,15 @@
 //! Forward kinematics: link world transforms from joint values, following URDF's
-//! `child = parent * origin * motion(axis, q)`.
+//! `child = parent * origin * motion(axis, q)`; and the name of the joint that moves a part.
 
 use glam::{Affine3A, Quat, Vec3};
 
 use super::{ArticulatedObject, JointKind};
+
+/// Name of the joint that moves movable part `k` (1 ..= K): what the exported URDF and GLB call
+/// it and what `joints.json` lists it as.
+pub fn part_joint(k: usize) -> String {
+    format!("joint_{k}")
+}
 
 /// Motion of a joint's child frame relative to the joint frame at value `q`.
 pub(super) fn joint_motion(kind: JointKind, axis: Vec3, q: f32) -> Affine3A {

@@ -40,6 +40,7 @@ use glam::{Affine3A, Vec2, Vec3};
 
 use crate::data::{DataError, FileSet, RgbaImage};
 
+pub use kinematics::part_joint;
 pub use mesh_io::{MeshFormat, load_mesh};
 pub use parts::{MERGE_PRISMATIC_SPAN, MERGE_REVOLUTE_SPAN, Part, Parts, is_merged_chain_joint};
 pub(crate) use primitives::BOX_FACES;

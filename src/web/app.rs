@@ -1,6 +1,6 @@
 //! The page's main job: a dataset (dropped, zipped, or the demo's procedural capture), its fit
 //! with progress events, previews and pause/cancel, and the fit's files for download. Each step
-//! is the crate's own code, the same the CLI runs; this file only converts at the boundary.
+//! is the crate's own pipeline, the same the CLI runs; this file only converts at the boundary.
 
 use std::rc::Rc;
 
@@ -10,11 +10,12 @@ use wasm_bindgen::prelude::*;
 use super::{context, js_error};
 use crate::data::{Dataset, FileSet, Split, State, read_zip, rebase_on_dataset_root};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
-use crate::fit::object::{FitConfig, fit_object};
+use crate::fit::object::FitConfig;
 use crate::fit::observer::{Command, Observer, Preview};
 use crate::fit::reconstruct::{Preset, Progress};
 use crate::gpu::now_seconds;
-use crate::synth::{Category, SynthParams, generate};
+use crate::pipeline::{self, FitInput, PipelineError};
+use crate::synth::Category;
 
 /// Seconds between two previews the page is sent.
 const PREVIEW_EVERY_S: f64 = 1.5;
@@ -103,17 +104,9 @@ pub fn catalogue() -> String {
     .to_string()
 }
 
-struct Loaded {
-    dataset: Dataset,
-    /// Used as the fit's id and the twin's name.
-    name: String,
-    /// The synthetic category, or "unknown" for user data (a label in the metrics).
-    category: String,
-}
-
-/// A validated dataset held in wasm memory.
+/// A validated dataset held in wasm memory, with the names its fit carries.
 #[wasm_bindgen(js_name = Dataset)]
-pub struct WebDataset(Rc<Loaded>);
+pub struct WebDataset(Rc<FitInput>);
 
 fn dataset_from(files: &FileSet, name: String) -> Result<WebDataset, JsError> {
     let dataset = Dataset::from_files(files).map_err(|problems| {
@@ -124,11 +117,7 @@ fn dataset_from(files: &FileSet, name: String) -> Result<WebDataset, JsError> {
             lines.join("\n")
         ))
     })?;
-    Ok(WebDataset(Rc::new(Loaded {
-        dataset,
-        name,
-        category: "unknown".into(),
-    })))
+    Ok(WebDataset(Rc::new(FitInput::user(dataset, name))))
 }
 
 #[wasm_bindgen(js_class = Dataset)]
@@ -163,36 +152,24 @@ impl WebDataset {
     ) -> Result<WebDataset, JsError> {
         let category = Category::parse(&category).map_err(|e| JsError::new(&e))?;
         let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
-        let object = generate(&SynthParams {
-            category,
-            movable_parts: Some(parts as usize),
-            seed: seed.into(),
-        })
-        .map_err(|e| JsError::new(&e))?;
+        let object =
+            pipeline::demo::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
         let ctx = context().await?;
-        let dataset = crate::render::capture_dataset(
-            &ctx,
-            &object,
-            &config.demo_capture(seed.into()),
-            &mut |p| {
-                let ev = js_object(&[
-                    ("done", number(p.done as u32)),
-                    ("total", number(p.total as u32)),
-                ]);
-                let _ = on_progress.call1(&JsValue::NULL, &ev);
-            },
-        )
+        let spec = config.demo_capture(seed.into());
+        let input = pipeline::demo::capture_demo(&ctx, &object, category, &spec, &mut |p| {
+            let ev = js_object(&[
+                ("done", number(p.done as u32)),
+                ("total", number(p.total as u32)),
+            ]);
+            let _ = on_progress.call1(&JsValue::NULL, &ev);
+        })
         .await
-        .map_err(|e| JsError::new(&format!("{}: {e}", object.name)))?;
-        Ok(WebDataset(Rc::new(Loaded {
-            dataset,
-            name: object.name.clone(),
-            category: category.name().into(),
-        })))
+        .map_err(js_error)?;
+        Ok(WebDataset(Rc::new(input)))
     }
 
     pub fn name(&self) -> String {
-        self.0.name.clone()
+        self.0.id.clone()
     }
 
     /// What `artmesh info` prints about it.
@@ -316,7 +293,6 @@ pub async fn fit(
 ) -> Result<FitResult, JsError> {
     let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
     let ctx = context().await?;
-    let loaded = dataset.0;
     let mut observer = PageObserver {
         config,
         on_event,
@@ -324,20 +300,14 @@ pub async fn fit(
         t0: now_seconds(),
         last_preview: None,
     };
-    let fit = fit_object(&ctx, &loaded.dataset, &config, &mut observer)
+    let run = pipeline::fit_and_export(&ctx, &dataset.0, &config, &mut observer)
         .await
-        .map_err(js_error)?;
-    let seconds = now_seconds() - observer.t0;
-    let folder = FitFolder::build(
-        &fit,
-        &loaded.dataset,
-        &config,
-        &loaded.name,
-        &loaded.category,
-        seconds,
-    )
-    .map_err(|e| JsError::new(&e))?;
-    Ok(FitResult(Rc::new(folder)))
+        .map_err(|e| match e {
+            // The page reads a message starting "cancelled" as the cancel it asked for.
+            PipelineError::Fit { source, .. } => js_error(source),
+            other => js_error(other),
+        })?;
+    Ok(FitResult(Rc::new(run.folder)))
 }
 
 /// A finished fit: its report, joints, twin and downloadable files.

@@ -8,7 +8,8 @@ use artmesh::data::Dataset;
 use artmesh::data::degrade::DepthDegradation;
 use artmesh::eval::{BenchmarkTable, ColumnSummary, EvalOptions, ObjectMetrics};
 use artmesh::fit::articulate::{Ablation, ArticulationConfig, GeometryUse, articulate};
-use artmesh::fit::object::{FitConfig, JointRecord, ObjectFit};
+use artmesh::export::JointRecord;
+use artmesh::fit::object::{FitConfig, ObjectFit};
 use artmesh::fit::observer::Unobserved;
 use artmesh::fit::reconstruct::{ReconstructionConfig, RemeshMode, reconstruct};
 use artmesh::gpu::{AdapterReport, GpuContext};
@@ -256,7 +257,7 @@ fn score(
     object: &SourceObject,
 ) -> Result<ObjectMetrics, String> {
     let id = &object.id;
-    fit.evaluate(dataset, id, &object.category, &EvalOptions::default())
+    artmesh::eval::evaluate_fit(fit, dataset, id, &object.category, &EvalOptions::default())
         .ok_or_else(|| format!("{id}: the captured object has no ground-truth joints"))?
         .map_err(|e| format!("{id}: {e}"))
 }
@@ -299,7 +300,7 @@ fn fit_one(
         reconstruct_s,
         articulate_s: seconds - reconstruct_s,
         metrics: score(&fit, dataset, object)?,
-        joints: fit.joint_records(),
+        joints: artmesh::export::joint_records(&fit),
         warnings: fit.articulation.warnings.clone(),
     };
     Ok((done, fit))

@@ -9,7 +9,8 @@ use artmesh::eval::joints::{
     JointPairMetrics, axis_angle_deg, axis_line_distance, match_joints, motion_error,
 };
 use artmesh::fit::articulate::{ArticulationConfig, articulate};
-use artmesh::fit::object::{FitConfig, JointRecord, ObjectFit};
+use artmesh::export::JointRecord;
+use artmesh::fit::object::{FitConfig, ObjectFit};
 use artmesh::fit::observer::Unobserved;
 use artmesh::fit::reconstruct::{Preset, reconstruct};
 use artmesh::gpu::{AdapterReport, GpuContext};
@@ -265,7 +266,7 @@ fn spread_run(
         seconds: start.elapsed().as_secs_f64(),
         psnr_optimised: states.iter().map(|s| s.psnr_optimised).collect(),
         remeshed_faces: states.iter().map(|s| s.remesh.faces_built).collect(),
-        joints: fit.joint_records(),
+        joints: artmesh::export::joint_records(&fit),
         gt_errors: against_gt(&fitted),
         seed_gt_errors: seeds_gt,
     };
