@@ -543,7 +543,8 @@ mod cli {
                 edge_pixels,
                 preview,
             } => {
-                use artmesh::fit::photometric::{self, PhotometricConfig, SceneSpec};
+                use artmesh::fit::photometric::{self, PhotometricConfig};
+                use artmesh::fixtures::photometric::{SceneSpec, synthetic_scene};
                 if let Some(path) = &preview
                     && path.exists()
                 {
@@ -568,7 +569,7 @@ mod cli {
                 };
                 let ctx = context()?;
                 let start = std::time::Instant::now();
-                let problem = pollster::block_on(photometric::synthetic_scene(&ctx, &spec))?;
+                let problem = pollster::block_on(synthetic_scene(&ctx, &spec))?;
                 eprintln!(
                     "learn: {category} at {size}x{size}, {views} views; starting mesh {} vertices, {} faces",
                     problem.field.num_vertices(),

@@ -5,10 +5,9 @@
 use serde::Serialize;
 
 use super::articulate::{Articulation, ArticulationConfig, articulate};
-use super::observer::{Observer, Unobserved};
-use super::reconstruct::{
-    Phase, Preset, Progress, Reconstruction, ReconstructionConfig, reconstruct,
-};
+use super::observer::{Observer, Phase, Progress, Unobserved};
+use super::preset::Preset;
+use super::reconstruct::{Reconstruction, ReconstructionConfig, reconstruct};
 use crate::data::{Dataset, GroundTruth, JointKind, State};
 use crate::eval::{EvalError, EvalOptions, ObjectMetrics, evaluate_object};
 use crate::gpu::{GpuContext, GpuResult};
