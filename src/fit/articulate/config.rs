@@ -129,8 +129,9 @@ pub struct ArticulationConfig {
     /// cabinet's Axis Ang from 18.1° (seeds) to 6.2° where constant rates drifted away.
     pub final_rate: f64,
     /// Whether the refined joints' magnitudes are registered along their axes
-    /// ([`register_along_axis`]). On the fast laptop it took the motion 0.51° → 0.15° from the
-    /// truth and the browser-vs-native gap 0.84° → 0.28° (README "Browser app").
+    /// ([`register_along_axis`](crate::articulation::axis_registration::register_along_axis)).
+    /// On the fast laptop it took the motion 0.51° → 0.15° from the truth and the
+    /// browser-vs-native gap 0.84° → 0.28° (README "Browser app").
     pub register_magnitude: bool,
     /// How the measured part surfaces are used.
     pub geometry: GeometryUse,

@@ -44,7 +44,8 @@ fn vertex_term(
     k: usize,
     surfaces: &[StateSurface; 2],
     weights: &VertexMotionWeights,
-    (g_fwd, g_bwd): (&[(DMat3, DVec3)], &[(DMat3, DVec3)]),
+    g_fwd: &[(DMat3, DVec3)],
+    g_bwd: &[(DMat3, DVec3)],
 ) -> GpuResult<VertexTerm> {
     let (mut vf, mut vb) = (vec![PartSums::default(); k], vec![PartSums::default(); k]);
     if !(weights.color > 0.0 || weights.opacity > 0.0) {
@@ -106,7 +107,7 @@ pub(super) async fn refine(
         } else {
             (vec![PartSums::default(); k], None)
         };
-        let (vf, vb, vertex_loss) = vertex_term(config, k, surfaces, &vertex, (&g_fwd, &g_bwd))?;
+        let (vf, vb, vertex_loss) = vertex_term(config, k, surfaces, &vertex, &g_fwd, &g_bwd)?;
         for part in (1..k).filter(|&p| trainable[p]) {
             let fw = sums_f[part]
                 .scaled(config.pixel_weight)
