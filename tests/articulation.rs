@@ -14,7 +14,7 @@ use artmesh::data::{JointKind, Split, State};
 use artmesh::eval::EvalOptions;
 use artmesh::fit::articulate::GeometryUse;
 use artmesh::fit::object::{FitConfig, tiny_fit, tiny_fit_with};
-use artmesh::fit::reconstruct::Preset;
+use artmesh::fit::preset::Preset;
 use artmesh::synth::Category;
 
 fn no_edit(_: &mut artmesh::data::Dataset) {}
