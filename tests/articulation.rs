@@ -14,7 +14,7 @@ use artmesh::data::{JointKind, Split, State};
 use artmesh::eval::{EvalOptions, evaluate_fit};
 use artmesh::fit::articulate::GeometryUse;
 use artmesh::fit::object::FitConfig;
-use artmesh::fit::reconstruct::Preset;
+use artmesh::fit::preset::Preset;
 use artmesh::fixtures::object::tiny_fit;
 use artmesh::synth::Category;
 

@@ -2,7 +2,8 @@
 //! its surface must raise the training PSNR and lower the loss (the rasterizer learns).
 #![cfg(not(target_arch = "wasm32"))]
 
-use artmesh::fit::photometric::{self, PhotometricConfig, SceneSpec};
+use artmesh::fit::photometric::{self, PhotometricConfig};
+use artmesh::fixtures::photometric::{SceneSpec, synthetic_scene};
 
 mod common;
 
@@ -10,7 +11,7 @@ use common::context;
 
 fn run(spec: SceneSpec, config: PhotometricConfig) -> photometric::PhotometricResult {
     let ctx = context();
-    let problem = pollster::block_on(photometric::synthetic_scene(&ctx, &spec)).unwrap();
+    let problem = pollster::block_on(synthetic_scene(&ctx, &spec)).unwrap();
     println!(
         "{} vertices, {} faces, {} views",
         problem.field.num_vertices(),

@@ -193,9 +193,10 @@ async fn loss_gradients_and_adam_match_cpu_in_the_browser() {
 #[wasm_bindgen_test]
 async fn a_short_photometric_fit_learns_and_repeats_in_the_browser() {
     use artmesh::fit::photometric;
+    use artmesh::fixtures::photometric::{short_fit, synthetic_scene};
     let ctx = context().await;
-    let (spec, config) = photometric::short_fit();
-    let problem = photometric::synthetic_scene(&ctx, &spec).await.unwrap();
+    let (spec, config) = short_fit();
+    let problem = synthetic_scene(&ctx, &spec).await.unwrap();
     let result = photometric::fit(&ctx, &problem, &config, &mut |_| {})
         .await
         .unwrap();

@@ -3,13 +3,15 @@
 //! [`init`] seeds a state's field from its depth maps; [`reconstruct`] is the paper's
 //! reconstruction phase per state (densify, prune, anneal, harden, part-aware remeshing,
 //! recovery). [`articulate`] is the articulation phase on its frozen meshes, [`object`] both
-//! phases on one object; [`observer`] is how a driver hears, previews, pauses and cancels them.
+//! phases on one object; [`observer`] is how a driver hears, previews, pauses and cancels them
+//! (and the progress events they report); [`preset`] names the budgets all of them spend.
 
 pub mod articulate;
 pub mod init;
 pub mod object;
 pub mod observer;
 pub mod photometric;
+pub mod preset;
 pub mod reconstruct;
 mod subdivide;
 mod views;

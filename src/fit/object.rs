@@ -6,10 +6,9 @@
 use serde::Serialize;
 
 use super::articulate::{Articulation, ArticulationConfig, articulate};
-use super::observer::Observer;
-use super::reconstruct::{
-    Phase, Preset, Progress, Reconstruction, ReconstructionConfig, reconstruct,
-};
+use super::observer::{Observer, Phase, Progress};
+use super::preset::{BudgetOverrides, Preset};
+use super::reconstruct::{Reconstruction, ReconstructionConfig, reconstruct};
 use crate::data::{Dataset, GroundTruth, State};
 use crate::gpu::{GpuContext, GpuResult};
 
@@ -23,9 +22,16 @@ pub struct FitConfig {
 impl FitConfig {
     /// Both phases' settings of a preset.
     pub fn preset(preset: Preset) -> Self {
+        Self::budgeted(preset, &BudgetOverrides::default())
+    }
+
+    /// Both phases' settings of a preset with some of its budgets (working size, views per
+    /// state, iteration counts) overridden: what the CLI's and the page's budget options set.
+    pub fn budgeted(preset: Preset, overrides: &BudgetOverrides) -> Self {
+        let budget = preset.budget().with(overrides);
         Self {
-            reconstruction: ReconstructionConfig::preset(preset),
-            articulation: ArticulationConfig::preset(preset),
+            reconstruction: ReconstructionConfig::budgeted(preset, &budget),
+            articulation: ArticulationConfig::budgeted(preset, &budget),
         }
     }
 

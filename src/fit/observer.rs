@@ -2,10 +2,89 @@
 //! progress events, may ask for a preview render of the state being reconstructed, and steers the
 //! fit (run, pause, cancel) at checkpoints between GPU submissions. In the browser a checkpoint
 //! is also where the fit hands the event loop a turn, so the page stays responsive.
+//! The events themselves ([`Progress`], in [`Phase`]s) live here too: every stage of the fit
+//! reports through this file, which depends on no other file of the fit.
 
-use super::reconstruct::Progress;
+use serde::Serialize;
+
 use crate::data::State;
 use crate::gpu::{GpuError, GpuResult, sleep_ms};
+
+/// Stages of the reconstruction, in order.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Phase {
+    Initialise,
+    Optimise,
+    Densify,
+    Remesh,
+    Recover,
+    /// Articulation: both joint-type candidates trained on alternating steps.
+    Candidates,
+    /// Articulation: the per-part joint-type decision.
+    BakeOff,
+    /// Articulation: the winners refined with both consistency terms.
+    Refine,
+    Done,
+}
+
+impl Phase {
+    /// Whether this is a stage of the articulation phase (both states at once).
+    pub fn is_articulation(self) -> bool {
+        matches!(self, Phase::Candidates | Phase::BakeOff | Phase::Refine)
+    }
+
+    /// The step of the method this phase belongs to, in the paper's words.
+    pub fn stage(self) -> &'static str {
+        match self {
+            Phase::Remesh => "remeshing",
+            Phase::Candidates | Phase::Refine => "articulation",
+            Phase::BakeOff => "bake-off decision",
+            _ => "reconstruction",
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            Phase::Initialise => "initialise",
+            Phase::Optimise => "optimise",
+            Phase::Densify => "densify",
+            Phase::Remesh => "remesh",
+            Phase::Recover => "recover",
+            Phase::Candidates => "candidates",
+            Phase::BakeOff => "bake-off",
+            Phase::Refine => "refine",
+            Phase::Done => "done",
+        }
+    }
+}
+
+/// A progress event: where the reconstruction is and how it is doing.
+#[derive(Debug, Clone, Copy, Serialize)]
+pub struct Progress {
+    pub state: State,
+    pub phase: Phase,
+    /// Iteration within the phase (optimise, recover) and the phase's length.
+    pub iteration: u32,
+    pub iterations: u32,
+    /// Total loss of the last step, when read back.
+    pub loss: Option<f32>,
+    /// Mean training PSNR (dB), when measured.
+    pub psnr: Option<f64>,
+    pub vertices: usize,
+    pub faces: usize,
+    /// Seconds since this state's reconstruction began.
+    pub elapsed_s: f64,
+}
+
+impl Progress {
+    /// Whether the event comes from the articulation phase: one of its stages, or its closing
+    /// [`Phase::Done`], the only `Done` that counts steps (a state's reconstruction ends with 0
+    /// of 0).
+    pub fn is_articulation(&self) -> bool {
+        self.phase.is_articulation() || (self.phase == Phase::Done && self.iterations > 0)
+    }
+}
 
 /// What the driver wants the fit to do next.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -3,7 +3,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use artmesh::fit::photometric::{self, PhotometricConfig, SceneSpec};
+use artmesh::fit::photometric::{self, PhotometricConfig};
+use artmesh::fixtures::photometric::{SceneSpec, synthetic_scene};
 
 use crate::args::{context, to_json};
 
@@ -73,7 +74,7 @@ pub fn run(args: &LearnArgs) -> Result<ExitCode, String> {
     };
     let ctx = context()?;
     let start = std::time::Instant::now();
-    let problem = pollster::block_on(photometric::synthetic_scene(&ctx, &spec))?;
+    let problem = pollster::block_on(synthetic_scene(&ctx, &spec))?;
     eprintln!(
         "learn: {category} at {size}x{size}, {views} views; starting mesh {} vertices, {} faces",
         problem.field.num_vertices(),

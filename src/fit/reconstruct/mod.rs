@@ -1,0 +1,87 @@
+//! The reconstruction phase (paper §3.1, DESIGN.md §5), run independently per articulation
+//! state:
+//!
+//! 1. **initialise** a triangle soup from the depth maps ([`super::init`]);
+//! 2. **optimise** positions, SH colour, opacity and part logits with the image loss, while
+//!    **densifying** (1 → 4 splits of visible faces larger than a few pixels) and **pruning**
+//!    (faces that never blend above a small weight, transparent ones, oversized ones) in a
+//!    window, and annealing γ and the opacity floor towards hard, opaque triangles;
+//! 3. **harden** part labels (argmax), drop the old faces (and with them every cross-part one),
+//!    and rebuild connectivity with **part-aware restricted Delaunay** per part
+//!    ([`crate::mesh::part_aware_remesh`]; [`RemeshMode::Global`] is the ablation), keeping the
+//!    pieces that are not tiny floaters;
+//! 4. **recover**: a short fit with the topology fixed, γ and the floor at their final values.
+//!
+//! Progress is reported as [`Progress`] events; the CLI draws them as a bar, the browser plots them.
+//!
+//! Files: `config` (settings per preset), `results` (what a state's reconstruction
+//! produces), `densify` (densification and pruning), `remesh` (hardening and remeshing),
+//! `state` (the stages of one state in order); this file picks the training views and runs
+//! both states.
+
+mod config;
+mod densify;
+mod remesh;
+mod results;
+mod state;
+
+pub use config::{DensifyConfig, ReconstructionConfig, RemeshMode};
+pub use results::{PhaseTimes, Reconstruction, RemeshStats, StateReconstruction};
+pub use state::reconstruct_state;
+// Their old home, for the callers outside fit that still import them from here.
+pub use super::observer::{Phase, Progress};
+pub use super::preset::Preset;
+
+use super::views::downsample_frame;
+use crate::data::{Dataset, Frame, Split, State};
+use crate::fit::observer::Observer;
+use crate::gpu::{GpuContext, GpuError, GpuResult};
+
+/// The training views of `state` under `config`: evenly spaced, downsampled.
+pub fn training_views(
+    dataset: &Dataset,
+    state: State,
+    config: &ReconstructionConfig,
+) -> Result<Vec<Frame>, String> {
+    let frames = dataset
+        .views(state, Split::Train)
+        .map(|v| &v.frames)
+        .filter(|f| !f.is_empty())
+        .ok_or_else(|| format!("the dataset has no {} training views", state.name()))?;
+    let n = frames.len();
+    let take = if config.max_views == 0 {
+        n
+    } else {
+        config.max_views.min(n)
+    };
+    let longest = frames[0].rgba.width.max(frames[0].rgba.height);
+    let factor = if config.max_size == 0 {
+        1
+    } else {
+        longest.div_ceil(config.max_size).max(1)
+    };
+    Ok((0..take)
+        .map(|i| downsample_frame(&frames[i * n / take], factor))
+        .collect())
+}
+
+/// Reconstructs both states of `dataset`.
+pub async fn reconstruct(
+    ctx: &GpuContext,
+    dataset: &Dataset,
+    config: &ReconstructionConfig,
+    observer: &mut dyn Observer,
+) -> GpuResult<Reconstruction> {
+    let mut states = Vec::new();
+    for state in [State::Start, State::End] {
+        let frames = training_views(dataset, state, config).map_err(GpuError::InvalidInput)?;
+        states.push(
+            reconstruct_state(ctx, state, &frames, dataset.num_parts, config, observer).await?,
+        );
+    }
+    Ok(Reconstruction {
+        config: *config,
+        num_parts: dataset.num_parts,
+        states,
+    })
+}
