@@ -25,6 +25,7 @@ pub mod mesh_quality;
 pub mod report;
 pub mod tables;
 
+pub use crate::synth::PartBucket;
 pub use chamfer::{
     ChamferDistance, ChamferOptions, chamfer_meshes, chamfer_points, sample_surface,
 };
@@ -34,7 +35,7 @@ pub use joints::{
 };
 pub use mesh_quality::{PartQuality, ReconstructionReport, StateQuality, reconstruction_report};
 pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_fit, evaluate_object};
-pub use tables::{BenchmarkTable, ColumnSummary, PartBucket};
+pub use tables::{BenchmarkTable, ColumnSummary};
 
 /// Why an object could not be evaluated.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]

@@ -3,8 +3,8 @@
 //!
 //! Every shape is a [`RenderMesh`] with outward counter-clockwise winding, unit normals and UVs of
 //! `position / TILE_METRES` along the face, so a texture keeps its scale whatever the part's size. A link's
-//! meshes become one visual (`Geometry::Mesh` at `meshes/<link>.obj`, what [`crate::export::write_urdf`]
-//! writes), and one box collision per link fitted to its bounds.
+//! meshes become one visual (`Geometry::Mesh` at `meshes/<link>.obj`, what the URDF export writes), and
+//! one box collision per link fitted to its bounds.
 
 use std::f32::consts::TAU;
 use std::sync::Arc;

@@ -10,11 +10,13 @@
 //! near the origin, its front faces −y (where cameras see doors and drawers open). Part 0 is the static body;
 //! every movable part hangs directly on it (no joint chains), so each part's motion is one joint.
 
+mod bucket;
 pub mod builder;
 mod categories;
 mod suite;
 pub mod texture;
 
+pub use bucket::PartBucket;
 pub use suite::{FULL_BUCKETS, SuiteEntry, SuiteKind, suite_plan};
 
 use std::ops::RangeInclusive;

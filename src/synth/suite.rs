@@ -5,8 +5,7 @@
 //! The plan is a pure function of nothing: the same list, with the same seeds, on every machine and in every
 //! version that keeps this file, so results on the suite can be compared across commits.
 
-use super::{Category, SynthParams};
-use crate::eval::PartBucket;
+use super::{Category, PartBucket, SynthParams};
 
 /// Objects per bucket in the full suite, in [`PartBucket::ALL`] order (the paper's 34 / 20 / 31 / 15).
 pub const FULL_BUCKETS: [usize; 4] = [34, 20, 31, 15];

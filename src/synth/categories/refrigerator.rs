@@ -191,6 +191,197 @@ fn bar_handle(
     }
 }
 
+/// Shell, liner, glass and handle materials and the door thickness.
+fn random_style(rng: &mut Rng) -> Style {
+    let shell = match rng.below(3) {
+        0 => random_material("shell", Finish::Metal, rng),
+        1 => random_material("shell", Finish::Paint, rng),
+        // White or cream enamel: nearly textureless.
+        _ => {
+            let tone = rng.uniform(0.8, 0.92);
+            let seed = rng.next_u64();
+            material(
+                "shell",
+                Finish::Plastic,
+                [tone, tone, tone * rng.uniform(0.9, 1.0)],
+                seed,
+            )
+        }
+    };
+    Style {
+        shell,
+        liner: material("liner", Finish::Plastic, [0.9, 0.92, 0.93], rng.next_u64()),
+        glass: material("shelf", Finish::Plastic, [0.6, 0.7, 0.72], rng.next_u64()),
+        handle: random_material("handle", *rng.pick(&[Finish::Metal, Finish::Plastic]), rng),
+        door_t: rng.uniform(0.045, 0.07),
+    }
+}
+
+/// The static cabinet: its outer corners and wall thickness.
+struct Cabinet {
+    lo: Vec3,
+    hi: Vec3,
+    wall: f32,
+}
+
+/// Toe kick under the cabinet, then the shell with its liner, `w` × `d` up to height `h`.
+fn cabinet(b: &mut ObjectBuilder, w: f32, d: f32, h: f32, s: &Style, rng: &mut Rng) -> Cabinet {
+    let wall = 0.035;
+    let base = ObjectBuilder::BASE;
+    let foot = rng.uniform(0.02, 0.05);
+    let dark = crate::synth::texture::plain("kick", [0.08, 0.08, 0.08]);
+    b.add(
+        base,
+        slab(
+            Vec3::new(-w / 2.0 + 0.02, -d / 2.0 + 0.04, 0.0),
+            Vec3::new(w / 2.0 - 0.02, d / 2.0 - 0.02, foot),
+            &dark,
+        ),
+    );
+    let lo = Vec3::new(-w / 2.0, -d / 2.0, foot);
+    let hi = Vec3::new(w / 2.0, d / 2.0, h);
+    open_box(b, base, lo, hi, wall, Open::Front, &s.shell);
+    // Liner: a thin white box just inside the walls.
+    open_box(
+        b,
+        base,
+        lo + Vec3::new(wall, 0.0, wall),
+        hi - Vec3::new(wall, wall, wall),
+        0.004,
+        Open::Front,
+        &s.liner,
+    );
+    Cabinet { lo, hi, wall }
+}
+
+/// The inside of compartment `i` of `count` spanning `[z0, z1]`: the divider below it and, behind doors,
+/// glass shelves. Returns its opening `[x0, x1, z0, z1]` inside the walls.
+fn compartment_inside(
+    b: &mut ObjectBuilder,
+    c: &Cabinet,
+    (i, count): (usize, usize),
+    [z0, z1]: [f32; 2],
+    row: Row,
+    s: &Style,
+) -> [f32; 4] {
+    let base = ObjectBuilder::BASE;
+    let (lo, hi, wall) = (c.lo, c.hi, c.wall);
+    let oz0 = if i == 0 { z0 + wall } else { z0 + wall * 0.5 };
+    let oz1 = if i + 1 == count {
+        z1 - wall
+    } else {
+        z1 - wall * 0.5
+    };
+    if i > 0 {
+        // Insulated divider between compartments.
+        b.add(
+            base,
+            slab(
+                Vec3::new(lo.x + wall, lo.y, z0 - wall * 0.5),
+                Vec3::new(hi.x - wall, hi.y - wall, z0 + wall * 0.5),
+                &s.liner,
+            ),
+        );
+    }
+    let (ox0, ox1) = (lo.x + wall, hi.x - wall);
+    // Glass shelves, set back behind the door bins.
+    if !matches!(row, Row::Drawer) {
+        let shelves = ((oz1 - oz0) / 0.3).floor() as usize;
+        for k in 1..shelves {
+            let zs = oz0 + (oz1 - oz0) * k as f32 / shelves as f32;
+            b.add(
+                base,
+                slab(
+                    Vec3::new(ox0, lo.y + 0.14, zs - 0.004),
+                    Vec3::new(ox1, hi.y - wall, zs + 0.004),
+                    &s.glass,
+                ),
+            );
+        }
+    }
+    [ox0, ox1, oz0, oz1]
+}
+
+/// How the fronts hang and how many of each are already named.
+struct Fronts {
+    hinge_left: bool,
+    upper: f32,
+    /// Depth of a freezer drawer's basket.
+    depth: f32,
+    doors: usize,
+    drawers: usize,
+}
+
+/// The door, door pair or drawer closing a compartment spanning `[z0, z1]` with inside `opening`.
+fn compartment_front(
+    b: &mut ObjectBuilder,
+    c: &Cabinet,
+    [z0, z1]: [f32; 2],
+    opening: [f32; 4],
+    row: Row,
+    f: &mut Fronts,
+    s: &Style,
+) {
+    let (lo, hi) = (c.lo, c.hi);
+    let [ox0, ox1, oz0, oz1] = opening;
+    match row {
+        Row::Door => {
+            fridge_door(
+                b,
+                &format!("door{}", f.doors),
+                [lo.x, hi.x, z0, z1],
+                opening,
+                lo.y,
+                f.hinge_left,
+                f.upper,
+                s,
+            );
+            f.doors += 1;
+        }
+        Row::Pair => {
+            // A thin mullion behind the meeting edges.
+            b.add(
+                ObjectBuilder::BASE,
+                slab(
+                    Vec3::new(-0.01, lo.y, oz0),
+                    Vec3::new(0.01, lo.y + 0.03, oz1),
+                    &s.liner,
+                ),
+            );
+            for left in [true, false] {
+                let (rx0, rx1, px0, px1) = if left {
+                    (lo.x, 0.0, ox0, -0.01)
+                } else {
+                    (0.0, hi.x, 0.01, ox1)
+                };
+                fridge_door(
+                    b,
+                    &format!("door{}", f.doors),
+                    [rx0, rx1, z0, z1],
+                    [px0, px1, oz0, oz1],
+                    lo.y,
+                    left,
+                    f.upper,
+                    s,
+                );
+                f.doors += 1;
+            }
+        }
+        Row::Drawer => {
+            freezer_drawer(
+                b,
+                &format!("drawer{}", f.drawers),
+                [lo.x, hi.x, z0, z1],
+                opening,
+                lo.y,
+                f.depth,
+                s,
+            );
+            f.drawers += 1;
+        }
+    }
+}
+
 /// Builds a refrigerator with exactly `parts` doors and drawers.
 pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     let rows = layout(parts, rng);
@@ -207,152 +398,25 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     } else {
         rng.uniform(1.55, 1.95)
     };
-    let wall = 0.035;
-    let shell = match rng.below(3) {
-        0 => random_material("shell", Finish::Metal, rng),
-        1 => random_material("shell", Finish::Paint, rng),
-        // White or cream enamel: nearly textureless.
-        _ => {
-            let tone = rng.uniform(0.8, 0.92);
-            let seed = rng.next_u64();
-            material(
-                "shell",
-                Finish::Plastic,
-                [tone, tone, tone * rng.uniform(0.9, 1.0)],
-                seed,
-            )
-        }
-    };
-    let s = Style {
-        shell,
-        liner: material("liner", Finish::Plastic, [0.9, 0.92, 0.93], rng.next_u64()),
-        glass: material("shelf", Finish::Plastic, [0.6, 0.7, 0.72], rng.next_u64()),
-        handle: random_material("handle", *rng.pick(&[Finish::Metal, Finish::Plastic]), rng),
-        door_t: rng.uniform(0.045, 0.07),
-    };
+    let s = random_style(rng);
     let hinge_left = rng.chance(0.5);
     let upper = rng.uniform(1.55, 1.9);
 
     let mut b = ObjectBuilder::new("refrigerator");
-    let base = ObjectBuilder::BASE;
-    // Toe kick under the cabinet, then the shell with its liner.
-    let foot = rng.uniform(0.02, 0.05);
-    let dark = crate::synth::texture::plain("kick", [0.08, 0.08, 0.08]);
-    b.add(
-        base,
-        slab(
-            Vec3::new(-w / 2.0 + 0.02, -d / 2.0 + 0.04, 0.0),
-            Vec3::new(w / 2.0 - 0.02, d / 2.0 - 0.02, foot),
-            &dark,
-        ),
-    );
-    let lo = Vec3::new(-w / 2.0, -d / 2.0, foot);
-    let hi = Vec3::new(w / 2.0, d / 2.0, h);
-    open_box(&mut b, base, lo, hi, wall, Open::Front, &s.shell);
-    // Liner: a thin white box just inside the walls.
-    open_box(
-        &mut b,
-        base,
-        lo + Vec3::new(wall, 0.0, wall),
-        hi - Vec3::new(wall, wall, wall),
-        0.004,
-        Open::Front,
-        &s.liner,
-    );
+    let c = cabinet(&mut b, w, d, h, &s, rng);
+    let mut fronts = Fronts {
+        hinge_left,
+        upper,
+        depth: d - c.wall - 0.03,
+        doors: 0,
+        drawers: 0,
+    };
     let weights: Vec<f32> = rows.iter().map(|r| r.0).collect();
-    let z = splits(lo.z, hi.z - lo.z, &weights);
-    let (mut doors, mut drawers) = (0, 0);
+    let z = splits(c.lo.z, c.hi.z - c.lo.z, &weights);
     for (i, &(_, row)) in rows.iter().enumerate() {
-        let (z0, z1) = (z[i], z[i + 1]);
-        let oz0 = if i == 0 { z0 + wall } else { z0 + wall * 0.5 };
-        let oz1 = if i + 1 == rows.len() {
-            z1 - wall
-        } else {
-            z1 - wall * 0.5
-        };
-        if i > 0 {
-            // Insulated divider between compartments.
-            b.add(
-                base,
-                slab(
-                    Vec3::new(lo.x + wall, lo.y, z0 - wall * 0.5),
-                    Vec3::new(hi.x - wall, hi.y - wall, z0 + wall * 0.5),
-                    &s.liner,
-                ),
-            );
-        }
-        let (ox0, ox1) = (lo.x + wall, hi.x - wall);
-        // Glass shelves, set back behind the door bins.
-        if !matches!(row, Row::Drawer) {
-            let shelves = ((oz1 - oz0) / 0.3).floor() as usize;
-            for k in 1..shelves {
-                let zs = oz0 + (oz1 - oz0) * k as f32 / shelves as f32;
-                b.add(
-                    base,
-                    slab(
-                        Vec3::new(ox0, lo.y + 0.14, zs - 0.004),
-                        Vec3::new(ox1, hi.y - wall, zs + 0.004),
-                        &s.glass,
-                    ),
-                );
-            }
-        }
-        match row {
-            Row::Door => {
-                fridge_door(
-                    &mut b,
-                    &format!("door{doors}"),
-                    [lo.x, hi.x, z0, z1],
-                    [ox0, ox1, oz0, oz1],
-                    lo.y,
-                    hinge_left,
-                    upper,
-                    &s,
-                );
-                doors += 1;
-            }
-            Row::Pair => {
-                // A thin mullion behind the meeting edges.
-                b.add(
-                    base,
-                    slab(
-                        Vec3::new(-0.01, lo.y, oz0),
-                        Vec3::new(0.01, lo.y + 0.03, oz1),
-                        &s.liner,
-                    ),
-                );
-                for left in [true, false] {
-                    let (rx0, rx1, px0, px1) = if left {
-                        (lo.x, 0.0, ox0, -0.01)
-                    } else {
-                        (0.0, hi.x, 0.01, ox1)
-                    };
-                    fridge_door(
-                        &mut b,
-                        &format!("door{doors}"),
-                        [rx0, rx1, z0, z1],
-                        [px0, px1, oz0, oz1],
-                        lo.y,
-                        left,
-                        upper,
-                        &s,
-                    );
-                    doors += 1;
-                }
-            }
-            Row::Drawer => {
-                freezer_drawer(
-                    &mut b,
-                    &format!("drawer{drawers}"),
-                    [lo.x, hi.x, z0, z1],
-                    [ox0, ox1, oz0, oz1],
-                    lo.y,
-                    d - wall - 0.03,
-                    &s,
-                );
-                drawers += 1;
-            }
-        }
+        let span = [z[i], z[i + 1]];
+        let opening = compartment_inside(&mut b, &c, (i, rows.len()), span, row, &s);
+        compartment_front(&mut b, &c, span, opening, row, &mut fronts, &s);
     }
     b.build()
 }

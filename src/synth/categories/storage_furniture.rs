@@ -89,205 +89,216 @@ fn drawer_rows(n: usize, m: usize, rng: &mut Rng) -> Vec<usize> {
 }
 
 /// Front layout, carcass width and height for `n` movable parts: `(bands, by_rows, width, height)`.
-fn layout(n: usize, rng: &mut Rng) -> (Vec<Band>, bool, f32, f32) {
+type Layout = (Vec<Band>, bool, f32, f32);
+
+/// Picks an archetype and lays out its front for `n` movable parts.
+fn layout(n: usize, rng: &mut Rng) -> Layout {
     match rng.below(4) {
-        // Chest of drawers / dresser / nightstand: rows of drawers, maybe an open niche at the bottom.
-        0 => {
-            let min_m = n.div_ceil(5).max(1);
-            let m = rng.int_in(min_m, (min_m + 1).min(3)).min(n);
-            let rows = drawer_rows(n, m, rng);
-            // `rows` runs bottom to top; bottom rows a little deeper.
-            let mut bands: Vec<Band> = rows
-                .iter()
-                .enumerate()
-                .map(|(i, &c)| Band {
-                    weight: 1.0 + 0.12 * (rows.len() - i) as f32,
-                    fills: drawers(c),
-                })
-                .collect();
-            // Low chests get an open niche below (a nightstand) so they do not read as a bare box.
-            if rows.len() == 1 || (rows.len() == 2 && rng.chance(0.5)) {
-                bands.insert(
-                    0,
-                    Band {
-                        weight: 1.6,
-                        fills: vec![(1.0, Fill::Open)],
-                    },
-                );
-            }
-            let cell_w = rng.uniform(0.4, 0.6);
-            let w = (m as f32 * cell_w).max(0.42);
-            let row_h = rng.uniform(0.14, 0.22);
-            let h: f32 = bands.iter().map(|b| b.weight).sum::<f32>() * row_h;
-            (bands, true, w, h)
-        }
-        // Cupboard / wardrobe: columns of one or two stacked doors (two doors side by side per column pair).
-        1 if n <= 8 => {
-            let stacked = n > 4 || (n >= 2 && rng.chance(0.35));
-            let cols = if stacked { n.div_ceil(2) } else { n };
-            let mut per_col = vec![if stacked { 2 } else { 1 }; cols];
-            if stacked && n % 2 == 1 {
-                let k = rng.below(cols as u32) as usize;
-                per_col[k] = 1;
-            }
-            let bands: Vec<Band> = per_col
-                .iter()
-                .enumerate()
-                .map(|(i, &k)| {
-                    let hinge_left = if 2 * i + 1 == cols {
-                        rng.chance(0.5)
-                    } else {
-                        2 * i + 1 < cols
-                    };
-                    Band {
-                        weight: 1.0,
-                        fills: vec![(1.0, Fill::Door { hinge_left }); k],
-                    }
-                })
-                .collect();
-            let w = cols as f32 * rng.uniform(0.38, 0.55);
-            let h = if stacked || rng.chance(0.5) {
-                rng.uniform(1.3, 2.0)
+        0 => chest_of_drawers(n, rng),
+        1 if n <= 8 => cupboard(n, rng),
+        2 if n >= 2 => hutch(n, rng),
+        _ => sideboard(n, rng),
+    }
+}
+
+/// Chest of drawers / dresser / nightstand: rows of drawers, maybe an open niche at the bottom.
+fn chest_of_drawers(n: usize, rng: &mut Rng) -> Layout {
+    let min_m = n.div_ceil(5).max(1);
+    let m = rng.int_in(min_m, (min_m + 1).min(3)).min(n);
+    let rows = drawer_rows(n, m, rng);
+    // `rows` runs bottom to top; bottom rows a little deeper.
+    let mut bands: Vec<Band> = rows
+        .iter()
+        .enumerate()
+        .map(|(i, &c)| Band {
+            weight: 1.0 + 0.12 * (rows.len() - i) as f32,
+            fills: drawers(c),
+        })
+        .collect();
+    // Low chests get an open niche below (a nightstand) so they do not read as a bare box.
+    if rows.len() == 1 || (rows.len() == 2 && rng.chance(0.5)) {
+        bands.insert(
+            0,
+            Band {
+                weight: 1.6,
+                fills: vec![(1.0, Fill::Open)],
+            },
+        );
+    }
+    let cell_w = rng.uniform(0.4, 0.6);
+    let w = (m as f32 * cell_w).max(0.42);
+    let row_h = rng.uniform(0.14, 0.22);
+    let h: f32 = bands.iter().map(|b| b.weight).sum::<f32>() * row_h;
+    (bands, true, w, h)
+}
+
+/// Cupboard / wardrobe: columns of one or two stacked doors (two doors side by side per column pair).
+fn cupboard(n: usize, rng: &mut Rng) -> Layout {
+    let stacked = n > 4 || (n >= 2 && rng.chance(0.35));
+    let cols = if stacked { n.div_ceil(2) } else { n };
+    let mut per_col = vec![if stacked { 2 } else { 1 }; cols];
+    if stacked && n % 2 == 1 {
+        let k = rng.below(cols as u32) as usize;
+        per_col[k] = 1;
+    }
+    let bands: Vec<Band> = per_col
+        .iter()
+        .enumerate()
+        .map(|(i, &k)| {
+            let hinge_left = if 2 * i + 1 == cols {
+                rng.chance(0.5)
             } else {
-                rng.uniform(0.6, 1.0)
+                2 * i + 1 < cols
             };
-            (bands, false, w, h)
-        }
-        // Tall hutch: doors (or an open niche) on top, rows of drawers, doors below.
-        2 if n >= 2 => {
-            let mut rem = n;
-            let top_doors = if rng.chance(0.2) {
-                0
-            } else {
-                rng.int_in(1, 2).min(rem - 1)
-            };
-            rem -= top_doors;
-            let bottom_doors = if rem >= 3 && rng.chance(0.6) {
-                rng.int_in(1, 2)
-            } else {
-                0
-            };
-            rem -= bottom_doors;
-            let m = rem.div_ceil(3).clamp(1, 3);
-            let rows = drawer_rows(rem, m, rng);
-            let mut bands = Vec::new();
-            if bottom_doors > 0 {
-                bands.push(Band {
-                    weight: 3.0,
-                    fills: door_row(bottom_doors, rng),
-                });
+            Band {
+                weight: 1.0,
+                fills: vec![(1.0, Fill::Door { hinge_left }); k],
             }
-            for &c in &rows {
-                bands.push(Band {
-                    weight: 1.0,
-                    fills: drawers(c),
-                });
-            }
-            let top = if top_doors == 0 {
-                vec![(1.0, Fill::Open)]
-            } else {
-                door_row(top_doors, rng)
-            };
-            bands.push(Band {
-                weight: rng.uniform(3.0, 4.5),
-                fills: top,
-            });
-            let widest = top_doors.max(bottom_doors).max(m);
-            let w = (widest as f32 * rng.uniform(0.4, 0.55)).max(0.6);
-            let total: f32 = bands.iter().map(|b| b.weight).sum();
-            let h = (total * rng.uniform(0.15, 0.2)).clamp(1.1, 2.1);
-            (bands, true, w, h)
-        }
-        // Sideboard: columns of drawers, doors, a drawer over a door, or an open niche.
-        _ => {
-            let cols = rng.int_in(1, 4).min(n).max(n.div_ceil(5));
-            // Each column starts with its minimum and grows up to its capacity until all parts are placed.
-            #[derive(Clone, Copy, PartialEq)]
-            enum Col {
-                Drawers,
-                Doors,
-                DrawerOverDoor,
-            }
-            let mut kinds: Vec<Col> = (0..cols)
-                .map(|_| match rng.below(3) {
-                    0 => Col::Drawers,
-                    1 => Col::Doors,
-                    _ => Col::DrawerOverDoor,
-                })
-                .collect();
-            let cap = |k: Col| match k {
-                Col::Drawers => 5,
-                Col::Doors => 2,
-                Col::DrawerOverDoor => 3,
-            };
-            let min = |k: Col| match k {
-                Col::DrawerOverDoor => 2,
-                _ => 1,
-            };
-            // Too few parts for the minimums, or too many for the capacities: fall back to drawer columns.
-            // (`cols` ≥ n / 5 and ≤ n, so all-drawer columns always fit.)
-            while kinds.iter().map(|&k| min(k)).sum::<usize>() > n
-                || kinds.iter().map(|&k| cap(k)).sum::<usize>() < n
-            {
-                match kinds.iter().position(|&k| k != Col::Drawers) {
-                    Some(i) => kinds[i] = Col::Drawers,
-                    None => break,
-                }
-            }
-            let mut counts: Vec<usize> = kinds.iter().map(|&k| min(k)).collect();
-            let mut placed: usize = counts.iter().sum();
-            while placed < n {
-                let open: Vec<usize> = (0..cols).filter(|&i| counts[i] < cap(kinds[i])).collect();
-                if open.is_empty() {
-                    break;
-                }
-                let i = *rng.pick(&open);
-                counts[i] += 1;
-                placed += 1;
-            }
-            let mut bands: Vec<Band> = kinds
-                .iter()
-                .zip(&counts)
-                .enumerate()
-                .map(|(i, (&kind, &k))| {
-                    let hinge_left = if 2 * i + 1 == cols {
-                        rng.chance(0.5)
-                    } else {
-                        2 * i + 1 < cols
-                    };
-                    let door = Fill::Door { hinge_left };
-                    let fills = match kind {
-                        Col::Drawers => drawers(k),
-                        Col::Doors => vec![(1.0, door); k],
-                        // A door below one or two drawers.
-                        Col::DrawerOverDoor => {
-                            let mut f = vec![(2.5, door)];
-                            f.extend(vec![(1.0, Fill::Drawer); k - 1]);
-                            f
-                        }
-                    };
-                    Band {
-                        weight: rng.uniform(0.9, 1.2),
-                        fills,
-                    }
-                })
-                .collect();
-            // Sometimes an open niche column in the middle of a wide sideboard.
-            if cols >= 2 && rng.chance(0.25) {
-                bands.insert(
-                    cols / 2,
-                    Band {
-                        weight: 0.8,
-                        fills: vec![(1.0, Fill::Open), (1.0, Fill::Open)],
-                    },
-                );
-            }
-            let tallest = counts.iter().copied().max().unwrap_or(1);
-            let w = bands.len() as f32 * rng.uniform(0.4, 0.55);
-            let h = (tallest as f32 * rng.uniform(0.15, 0.2)).max(rng.uniform(0.6, 0.9));
-            (bands, false, w, h)
+        })
+        .collect();
+    let w = cols as f32 * rng.uniform(0.38, 0.55);
+    let h = if stacked || rng.chance(0.5) {
+        rng.uniform(1.3, 2.0)
+    } else {
+        rng.uniform(0.6, 1.0)
+    };
+    (bands, false, w, h)
+}
+
+/// Tall hutch: doors (or an open niche) on top, rows of drawers, doors below.
+fn hutch(n: usize, rng: &mut Rng) -> Layout {
+    let mut rem = n;
+    let top_doors = if rng.chance(0.2) {
+        0
+    } else {
+        rng.int_in(1, 2).min(rem - 1)
+    };
+    rem -= top_doors;
+    let bottom_doors = if rem >= 3 && rng.chance(0.6) {
+        rng.int_in(1, 2)
+    } else {
+        0
+    };
+    rem -= bottom_doors;
+    let m = rem.div_ceil(3).clamp(1, 3);
+    let rows = drawer_rows(rem, m, rng);
+    let mut bands = Vec::new();
+    if bottom_doors > 0 {
+        bands.push(Band {
+            weight: 3.0,
+            fills: door_row(bottom_doors, rng),
+        });
+    }
+    for &c in &rows {
+        bands.push(Band {
+            weight: 1.0,
+            fills: drawers(c),
+        });
+    }
+    let top = if top_doors == 0 {
+        vec![(1.0, Fill::Open)]
+    } else {
+        door_row(top_doors, rng)
+    };
+    bands.push(Band {
+        weight: rng.uniform(3.0, 4.5),
+        fills: top,
+    });
+    let widest = top_doors.max(bottom_doors).max(m);
+    let w = (widest as f32 * rng.uniform(0.4, 0.55)).max(0.6);
+    let total: f32 = bands.iter().map(|b| b.weight).sum();
+    let h = (total * rng.uniform(0.15, 0.2)).clamp(1.1, 2.1);
+    (bands, true, w, h)
+}
+
+/// Sideboard: columns of drawers, doors, a drawer over a door, or an open niche.
+fn sideboard(n: usize, rng: &mut Rng) -> Layout {
+    let cols = rng.int_in(1, 4).min(n).max(n.div_ceil(5));
+    // Each column starts with its minimum and grows up to its capacity until all parts are placed.
+    #[derive(Clone, Copy, PartialEq)]
+    enum Col {
+        Drawers,
+        Doors,
+        DrawerOverDoor,
+    }
+    let mut kinds: Vec<Col> = (0..cols)
+        .map(|_| match rng.below(3) {
+            0 => Col::Drawers,
+            1 => Col::Doors,
+            _ => Col::DrawerOverDoor,
+        })
+        .collect();
+    let cap = |k: Col| match k {
+        Col::Drawers => 5,
+        Col::Doors => 2,
+        Col::DrawerOverDoor => 3,
+    };
+    let min = |k: Col| match k {
+        Col::DrawerOverDoor => 2,
+        _ => 1,
+    };
+    // Too few parts for the minimums, or too many for the capacities: fall back to drawer columns.
+    // (`cols` ≥ n / 5 and ≤ n, so all-drawer columns always fit.)
+    while kinds.iter().map(|&k| min(k)).sum::<usize>() > n
+        || kinds.iter().map(|&k| cap(k)).sum::<usize>() < n
+    {
+        match kinds.iter().position(|&k| k != Col::Drawers) {
+            Some(i) => kinds[i] = Col::Drawers,
+            None => break,
         }
     }
+    let mut counts: Vec<usize> = kinds.iter().map(|&k| min(k)).collect();
+    let mut placed: usize = counts.iter().sum();
+    while placed < n {
+        let open: Vec<usize> = (0..cols).filter(|&i| counts[i] < cap(kinds[i])).collect();
+        if open.is_empty() {
+            break;
+        }
+        let i = *rng.pick(&open);
+        counts[i] += 1;
+        placed += 1;
+    }
+    let mut bands: Vec<Band> = kinds
+        .iter()
+        .zip(&counts)
+        .enumerate()
+        .map(|(i, (&kind, &k))| {
+            let hinge_left = if 2 * i + 1 == cols {
+                rng.chance(0.5)
+            } else {
+                2 * i + 1 < cols
+            };
+            let door = Fill::Door { hinge_left };
+            let fills = match kind {
+                Col::Drawers => drawers(k),
+                Col::Doors => vec![(1.0, door); k],
+                // A door below one or two drawers.
+                Col::DrawerOverDoor => {
+                    let mut f = vec![(2.5, door)];
+                    f.extend(vec![(1.0, Fill::Drawer); k - 1]);
+                    f
+                }
+            };
+            Band {
+                weight: rng.uniform(0.9, 1.2),
+                fills,
+            }
+        })
+        .collect();
+    // Sometimes an open niche column in the middle of a wide sideboard.
+    if cols >= 2 && rng.chance(0.25) {
+        bands.insert(
+            cols / 2,
+            Band {
+                weight: 0.8,
+                fills: vec![(1.0, Fill::Open), (1.0, Fill::Open)],
+            },
+        );
+    }
+    let tallest = counts.iter().copied().max().unwrap_or(1);
+    let w = bands.len() as f32 * rng.uniform(0.4, 0.55);
+    let h = (tallest as f32 * rng.uniform(0.15, 0.2)).max(rng.uniform(0.6, 0.9));
+    (bands, false, w, h)
 }
 
 /// Builds a storage unit with exactly `parts` drawers and doors.

@@ -80,6 +80,246 @@ fn telescopic(
     }
 }
 
+/// The suitcase's materials.
+struct Materials {
+    shell: Material,
+    trim: Material,
+    metal: Material,
+    lining: Material,
+}
+
+/// Shell length, width and thickness.
+#[derive(Clone, Copy)]
+struct Size {
+    len: f32,
+    wid: f32,
+    thick: f32,
+}
+
+/// Shell wall thickness.
+const WALL: f32 = 0.008;
+
+/// Lying on its back: base and clamshell lid, then the telescopic and side handles as parts allow.
+fn lying(b: &mut ObjectBuilder, parts: usize, size: Size, m: &Materials, rng: &mut Rng) {
+    let Size { len, wid, thick } = size;
+    let t = WALL;
+    let base = ObjectBuilder::BASE;
+    // Lying on its back: length along x, width along y, thickness along z.
+    let foot = 0.012;
+    for sx in [-1.0f32, 1.0] {
+        for sy in [-1.0f32, 1.0] {
+            let p = Vec3::new(sx * (len / 2.0 - 0.05), sy * (wid / 2.0 - 0.05), 0.0);
+            b.add(base, cylinder(p, p + Vec3::Z * foot, 0.015, &m.trim));
+        }
+    }
+    let split = foot + thick * rng.uniform(0.5, 0.6);
+    let lo = Vec3::new(-len / 2.0, -wid / 2.0, foot);
+    open_box(
+        b,
+        base,
+        lo,
+        Vec3::new(len / 2.0, wid / 2.0, split),
+        t,
+        Open::Top,
+        &m.shell,
+    );
+    b.add(
+        base,
+        slab(
+            Vec3::new(-len / 2.0 + t, -wid / 2.0 + t, foot + t),
+            Vec3::new(len / 2.0 - t, wid / 2.0 - t, foot + t + 0.003),
+            &m.lining,
+        ),
+    );
+    // Clamshell lid hinged along the back top edge; positive angles lift its front.
+    let lid = b.joint(
+        "lid",
+        base,
+        JointKind::Revolute,
+        Vec3::new(0.0, wid / 2.0, split),
+        Vec3::NEG_X,
+        0.0,
+        rng.uniform(1.7, 2.0),
+    );
+    let top = foot + thick;
+    open_box(
+        b,
+        lid,
+        Vec3::new(-len / 2.0, -wid / 2.0, split + GAP),
+        Vec3::new(len / 2.0, wid / 2.0, top),
+        t,
+        Open::Bottom,
+        &m.shell,
+    );
+    b.add(
+        lid,
+        slab(
+            Vec3::new(-len / 2.0 + t, -wid / 2.0 + t, top - t - 0.003),
+            Vec3::new(len / 2.0 - t, wid / 2.0 - t, top - t),
+            &m.lining,
+        ),
+    );
+    // Ribs across the lid give the shell its moulded look.
+    let ribs = rng.int_in(2, 5);
+    for k in 0..ribs {
+        let x = -len / 2.0 + len * (k as f32 + 1.0) / (ribs as f32 + 1.0);
+        b.add(
+            lid,
+            slab(
+                Vec3::new(x - 0.012, -wid / 2.0 + 0.04, top),
+                Vec3::new(x + 0.012, wid / 2.0 - 0.04, top + 0.006),
+                &m.shell,
+            ),
+        );
+    }
+    if parts >= 2 {
+        // Out of the −x end, low in the base, sliding out along −x.
+        let travel = rng.uniform(0.3, 0.45);
+        telescopic(
+            b,
+            Vec3::new(-len / 2.0 - 0.018, 0.0, foot + 0.035),
+            Vec3::NEG_X,
+            Vec3::Y,
+            wid * 0.5,
+            travel + 0.05,
+            travel,
+            &m.trim,
+            &m.metal,
+        );
+    }
+    if parts >= 3 {
+        // On the front side of the base, flipping out about its lower edge.
+        let z = foot + (split - foot) * 0.3;
+        carry_handle(
+            b,
+            "side_handle",
+            Vec3::new(0.0, -wid / 2.0 - GAP, z),
+            Vec3::X,
+            Vec3::X,
+            Vec3::Z * ((split - z) * 0.75),
+            Vec3::NEG_Y,
+            len * 0.25,
+            rng.uniform(1.3, 1.6),
+            &m.trim,
+        );
+    }
+}
+
+/// Standing on spinner wheels: the telescopic handle, then the top and side carry handles as parts allow.
+fn standing(b: &mut ObjectBuilder, parts: usize, size: Size, m: &Materials, rng: &mut Rng) {
+    let Size { len, wid, thick } = size;
+    let base = ObjectBuilder::BASE;
+    // Standing on spinner wheels: width along x, depth along y, height along z.
+    let (w, d, h) = (wid, thick, len);
+    let wheel = rng.uniform(0.035, 0.05);
+    for sx in [-1.0f32, 1.0] {
+        for sy in [-1.0f32, 1.0] {
+            let p = Vec3::new(sx * (w / 2.0 - 0.04), sy * (d / 2.0 - 0.04), 0.0);
+            b.add(
+                base,
+                cylinder(
+                    p + Vec3::new(-0.012, 0.0, wheel / 2.0),
+                    p + Vec3::new(0.012, 0.0, wheel / 2.0),
+                    wheel / 2.0,
+                    &m.trim,
+                ),
+            );
+            b.add(
+                base,
+                slab(
+                    p + Vec3::new(-0.015, -0.015, wheel * 0.6),
+                    p + Vec3::new(0.015, 0.015, wheel + 0.012),
+                    &m.trim,
+                ),
+            );
+        }
+    }
+    let z0 = wheel + 0.012;
+    let seam = -d / 2.0 + d * rng.uniform(0.4, 0.5);
+    // Front and back halves of the shell with a dark zip band between them.
+    b.add(
+        base,
+        slab(
+            Vec3::new(-w / 2.0, -d / 2.0, z0),
+            Vec3::new(w / 2.0, seam - 0.006, z0 + h),
+            &m.shell,
+        ),
+    );
+    b.add(
+        base,
+        slab(
+            Vec3::new(-w / 2.0 + 0.004, seam - 0.006, z0 + 0.004),
+            Vec3::new(w / 2.0 - 0.004, seam + 0.006, z0 + h - 0.004),
+            &m.trim,
+        ),
+    );
+    b.add(
+        base,
+        slab(
+            Vec3::new(-w / 2.0, seam + 0.006, z0),
+            Vec3::new(w / 2.0, d / 2.0, z0 + h),
+            &m.shell,
+        ),
+    );
+    let ribs = rng.int_in(2, 4);
+    for k in 0..ribs {
+        let x = -w / 2.0 + w * (k as f32 + 1.0) / (ribs as f32 + 1.0);
+        b.add(
+            base,
+            slab(
+                Vec3::new(x - 0.01, -d / 2.0 - 0.005, z0 + 0.05),
+                Vec3::new(x + 0.01, -d / 2.0, z0 + h - 0.05),
+                &m.shell,
+            ),
+        );
+    }
+    let top = z0 + h;
+    // Telescopic handle at the back of the top, its tubes hidden in the shell.
+    let travel = rng.uniform(0.3, 0.5);
+    telescopic(
+        b,
+        Vec3::new(0.0, d / 2.0 - 0.03, top + 0.016),
+        Vec3::Z,
+        Vec3::X,
+        w * 0.55,
+        travel + 0.05,
+        travel,
+        &m.trim,
+        &m.metal,
+    );
+    if parts >= 2 {
+        // Top carry handle lying flat towards the front; it flips up about an axis along x.
+        carry_handle(
+            b,
+            "top_handle",
+            Vec3::new(0.0, -0.005, top + GAP),
+            Vec3::NEG_X,
+            Vec3::X,
+            Vec3::NEG_Y * (d * 0.3),
+            Vec3::Z,
+            w * 0.3,
+            rng.uniform(1.3, 1.6),
+            &m.trim,
+        );
+    }
+    if parts >= 3 {
+        // Side carry handle on the +x face, flipping out about its lower edge.
+        let z = z0 + h * 0.45;
+        carry_handle(
+            b,
+            "side_handle",
+            Vec3::new(w / 2.0 + GAP, 0.0, z),
+            Vec3::Y,
+            Vec3::Y,
+            Vec3::Z * 0.06,
+            Vec3::X,
+            d * 0.45,
+            rng.uniform(1.3, 1.6),
+            &m.trim,
+        );
+    }
+}
+
 /// Builds a suitcase with exactly `parts` moving parts.
 pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     let shell = random_material(
@@ -95,223 +335,21 @@ pub(super) fn build(parts: usize, rng: &mut Rng) -> ArticulatedObject {
     let trim = plain("trim", [0.04, 0.04, 0.045]);
     let metal = random_material("tubes", Finish::Metal, rng);
     let lining = random_material("lining", Finish::Paint, rng);
+    let m = Materials {
+        shell,
+        trim,
+        metal,
+        lining,
+    };
     let len = rng.uniform(0.5, 0.75);
     let wid = len * rng.uniform(0.6, 0.72);
     let thick = rng.uniform(0.2, 0.3);
-    let t = 0.008;
+    let size = Size { len, wid, thick };
     let mut b = ObjectBuilder::new("suitcase");
-    let base = ObjectBuilder::BASE;
-
     if rng.chance(0.5) {
-        // Lying on its back: length along x, width along y, thickness along z.
-        let foot = 0.012;
-        for sx in [-1.0f32, 1.0] {
-            for sy in [-1.0f32, 1.0] {
-                let p = Vec3::new(sx * (len / 2.0 - 0.05), sy * (wid / 2.0 - 0.05), 0.0);
-                b.add(base, cylinder(p, p + Vec3::Z * foot, 0.015, &trim));
-            }
-        }
-        let split = foot + thick * rng.uniform(0.5, 0.6);
-        let lo = Vec3::new(-len / 2.0, -wid / 2.0, foot);
-        open_box(
-            &mut b,
-            base,
-            lo,
-            Vec3::new(len / 2.0, wid / 2.0, split),
-            t,
-            Open::Top,
-            &shell,
-        );
-        b.add(
-            base,
-            slab(
-                Vec3::new(-len / 2.0 + t, -wid / 2.0 + t, foot + t),
-                Vec3::new(len / 2.0 - t, wid / 2.0 - t, foot + t + 0.003),
-                &lining,
-            ),
-        );
-        // Clamshell lid hinged along the back top edge; positive angles lift its front.
-        let lid = b.joint(
-            "lid",
-            base,
-            JointKind::Revolute,
-            Vec3::new(0.0, wid / 2.0, split),
-            Vec3::NEG_X,
-            0.0,
-            rng.uniform(1.7, 2.0),
-        );
-        let top = foot + thick;
-        open_box(
-            &mut b,
-            lid,
-            Vec3::new(-len / 2.0, -wid / 2.0, split + GAP),
-            Vec3::new(len / 2.0, wid / 2.0, top),
-            t,
-            Open::Bottom,
-            &shell,
-        );
-        b.add(
-            lid,
-            slab(
-                Vec3::new(-len / 2.0 + t, -wid / 2.0 + t, top - t - 0.003),
-                Vec3::new(len / 2.0 - t, wid / 2.0 - t, top - t),
-                &lining,
-            ),
-        );
-        // Ribs across the lid give the shell its moulded look.
-        let ribs = rng.int_in(2, 5);
-        for k in 0..ribs {
-            let x = -len / 2.0 + len * (k as f32 + 1.0) / (ribs as f32 + 1.0);
-            b.add(
-                lid,
-                slab(
-                    Vec3::new(x - 0.012, -wid / 2.0 + 0.04, top),
-                    Vec3::new(x + 0.012, wid / 2.0 - 0.04, top + 0.006),
-                    &shell,
-                ),
-            );
-        }
-        if parts >= 2 {
-            // Out of the −x end, low in the base, sliding out along −x.
-            let travel = rng.uniform(0.3, 0.45);
-            telescopic(
-                &mut b,
-                Vec3::new(-len / 2.0 - 0.018, 0.0, foot + 0.035),
-                Vec3::NEG_X,
-                Vec3::Y,
-                wid * 0.5,
-                travel + 0.05,
-                travel,
-                &trim,
-                &metal,
-            );
-        }
-        if parts >= 3 {
-            // On the front side of the base, flipping out about its lower edge.
-            let z = foot + (split - foot) * 0.3;
-            carry_handle(
-                &mut b,
-                "side_handle",
-                Vec3::new(0.0, -wid / 2.0 - GAP, z),
-                Vec3::X,
-                Vec3::X,
-                Vec3::Z * ((split - z) * 0.75),
-                Vec3::NEG_Y,
-                len * 0.25,
-                rng.uniform(1.3, 1.6),
-                &trim,
-            );
-        }
+        lying(&mut b, parts, size, &m, rng);
     } else {
-        // Standing on spinner wheels: width along x, depth along y, height along z.
-        let (w, d, h) = (wid, thick, len);
-        let wheel = rng.uniform(0.035, 0.05);
-        for sx in [-1.0f32, 1.0] {
-            for sy in [-1.0f32, 1.0] {
-                let p = Vec3::new(sx * (w / 2.0 - 0.04), sy * (d / 2.0 - 0.04), 0.0);
-                b.add(
-                    base,
-                    cylinder(
-                        p + Vec3::new(-0.012, 0.0, wheel / 2.0),
-                        p + Vec3::new(0.012, 0.0, wheel / 2.0),
-                        wheel / 2.0,
-                        &trim,
-                    ),
-                );
-                b.add(
-                    base,
-                    slab(
-                        p + Vec3::new(-0.015, -0.015, wheel * 0.6),
-                        p + Vec3::new(0.015, 0.015, wheel + 0.012),
-                        &trim,
-                    ),
-                );
-            }
-        }
-        let z0 = wheel + 0.012;
-        let seam = -d / 2.0 + d * rng.uniform(0.4, 0.5);
-        // Front and back halves of the shell with a dark zip band between them.
-        b.add(
-            base,
-            slab(
-                Vec3::new(-w / 2.0, -d / 2.0, z0),
-                Vec3::new(w / 2.0, seam - 0.006, z0 + h),
-                &shell,
-            ),
-        );
-        b.add(
-            base,
-            slab(
-                Vec3::new(-w / 2.0 + 0.004, seam - 0.006, z0 + 0.004),
-                Vec3::new(w / 2.0 - 0.004, seam + 0.006, z0 + h - 0.004),
-                &trim,
-            ),
-        );
-        b.add(
-            base,
-            slab(
-                Vec3::new(-w / 2.0, seam + 0.006, z0),
-                Vec3::new(w / 2.0, d / 2.0, z0 + h),
-                &shell,
-            ),
-        );
-        let ribs = rng.int_in(2, 4);
-        for k in 0..ribs {
-            let x = -w / 2.0 + w * (k as f32 + 1.0) / (ribs as f32 + 1.0);
-            b.add(
-                base,
-                slab(
-                    Vec3::new(x - 0.01, -d / 2.0 - 0.005, z0 + 0.05),
-                    Vec3::new(x + 0.01, -d / 2.0, z0 + h - 0.05),
-                    &shell,
-                ),
-            );
-        }
-        let top = z0 + h;
-        // Telescopic handle at the back of the top, its tubes hidden in the shell.
-        let travel = rng.uniform(0.3, 0.5);
-        telescopic(
-            &mut b,
-            Vec3::new(0.0, d / 2.0 - 0.03, top + 0.016),
-            Vec3::Z,
-            Vec3::X,
-            w * 0.55,
-            travel + 0.05,
-            travel,
-            &trim,
-            &metal,
-        );
-        if parts >= 2 {
-            // Top carry handle lying flat towards the front; it flips up about an axis along x.
-            carry_handle(
-                &mut b,
-                "top_handle",
-                Vec3::new(0.0, -0.005, top + GAP),
-                Vec3::NEG_X,
-                Vec3::X,
-                Vec3::NEG_Y * (d * 0.3),
-                Vec3::Z,
-                w * 0.3,
-                rng.uniform(1.3, 1.6),
-                &trim,
-            );
-        }
-        if parts >= 3 {
-            // Side carry handle on the +x face, flipping out about its lower edge.
-            let z = z0 + h * 0.45;
-            carry_handle(
-                &mut b,
-                "side_handle",
-                Vec3::new(w / 2.0 + GAP, 0.0, z),
-                Vec3::Y,
-                Vec3::Y,
-                Vec3::Z * 0.06,
-                Vec3::X,
-                d * 0.45,
-                rng.uniform(1.3, 1.6),
-                &trim,
-            );
-        }
+        standing(&mut b, parts, size, &m, rng);
     }
     b.build()
 }
