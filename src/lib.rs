@@ -10,6 +10,7 @@ pub mod data;
 pub mod eval;
 pub mod export;
 pub mod fit;
+pub mod fixtures;
 pub mod gpu;
 pub mod loss;
 pub mod mesh;
