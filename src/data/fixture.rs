@@ -9,8 +9,9 @@ use glam::{Quat, Vec3};
 use serde_json::{Value, json};
 
 use super::camera::{Camera, Intrinsics, look_at};
-use super::dataset::{Dataset, Frame, ViewSet};
+use super::dataset::{Dataset, ViewSet};
 use super::error::DataError;
+use super::frame::Frame;
 use super::gt::{self, GtJoint, GtMeshes, JointKind};
 use super::image_io::{DepthMap, PartMap, RgbaImage};
 use super::npy::encode_npy;
