@@ -5,10 +5,11 @@
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 
-use artmesh::data::fixture::{FixtureParams, good_files, malformed_catalogue, small_dataset};
+use artmesh::data::fixture::{FixtureParams, small_dataset};
 use artmesh::data::{
     DataError, Dataset, DatasetErrors, FileSet, PngPixels, Split, State, encode_png,
 };
+use artmesh::fixtures::malformed::{good_files, malformed_catalogue};
 
 /// Reads without letting a panic escape: a panic is a test failure of its own.
 fn read_no_panic(files: &FileSet) -> Result<Result<Dataset, DatasetErrors>, String> {

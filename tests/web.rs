@@ -65,8 +65,9 @@ fn dataset_round_trip_in_wasm() {
 
 #[wasm_bindgen_test]
 fn malformed_datasets_give_clear_errors_in_wasm() {
-    use artmesh::data::{Dataset, fixture};
-    let cases = fixture::malformed_catalogue();
+    use artmesh::data::Dataset;
+    use artmesh::fixtures::malformed;
+    let cases = malformed::malformed_catalogue();
     assert!(cases.len() >= 15);
     for case in cases {
         match Dataset::from_files(&case.files()) {

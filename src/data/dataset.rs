@@ -4,31 +4,15 @@ use std::collections::BTreeSet;
 
 use super::camera::Camera;
 use super::error::{DataError, DatasetErrors, Errors};
-use super::gt::{self, GtJoint, GtMeshes};
-use super::image_io::{self, DepthMap, PartMap, RgbaImage};
+use super::frame::{Frame, size_error};
+use super::gt::{self, GtJoint, GtMeshes, implied_num_parts, write_ground_truth};
+use super::image_io;
 use super::npy;
 use super::paths;
-use super::ply::{PlyFormat, TriMesh};
+use super::ply::TriMesh;
 use super::transforms::{self, FrameSpec};
-use super::writer::DatasetWriter;
+use super::writer::{DatasetWriter, WriteOptions};
 use super::{FileSet, GT_TRANS_PATH, Split, State, transforms_file_name};
-
-/// One view: camera, colour, and optional depth and part ids, all of the same size.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Frame {
-    /// File stem of the colour image, e.g. `"0000"`; names the frame's files when written.
-    pub name: String,
-    /// Pose and intrinsics.
-    pub camera: Camera,
-    /// Articulation time: 0 = start, 1 = end.
-    pub time: f32,
-    /// Colour; alpha is the foreground mask.
-    pub rgba: RgbaImage,
-    /// Depth in millimetres, if the dataset has depth.
-    pub depth: Option<DepthMap>,
-    /// Part ids, if the dataset has semantic maps.
-    pub parts: Option<PartMap>,
-}
 
 /// The frames of one state and split.
 #[derive(Debug, Clone, PartialEq)]
@@ -54,45 +38,6 @@ pub struct Dataset {
     pub gt_joints: Option<Vec<GtJoint>>,
     /// Ground-truth meshes per state, indexed by [`State::index`].
     pub gt_meshes: [Option<GtMeshes>; 2],
-}
-
-/// How [`Dataset::to_files_with`] writes semantic maps.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub enum SemanticFormat {
-    /// Our 16-bit PNG (0 = background, k+1 = part k).
-    #[default]
-    Png,
-    /// GaussianArt-style `.npy` of `<i4` part ids (-1 = background).
-    Npy,
-}
-
-/// Options of the writer.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
-pub struct WriteOptions {
-    /// Semantic map encoding.
-    pub semantic: SemanticFormat,
-}
-
-/// Part count implied by the ground-truth joints, the largest part id seen and the GT mesh count: one rule for
-/// reader and writer. With `gt/trans.json` it is 1 + joints; otherwise 1 + the largest id or mesh index.
-pub(crate) fn implied_num_parts(
-    joints: Option<&[GtJoint]>,
-    max_id: Option<i16>,
-    meshes: &[Option<GtMeshes>; 2],
-) -> usize {
-    let max_movable_meshes = meshes
-        .iter()
-        .flatten()
-        .map(|m| m.movable.len())
-        .max()
-        .unwrap_or(0);
-    match joints {
-        Some(j) => 1 + j.len(),
-        None => {
-            let from_ids = max_id.map_or(0, |m| usize::try_from(i32::from(m) + 1).unwrap_or(0));
-            from_ids.max(1 + max_movable_meshes)
-        }
-    }
 }
 
 /// Frames of one split seen so far, for checks across frames.
@@ -253,21 +198,6 @@ fn read_view_set(
     })
 }
 
-pub(crate) fn size_error(
-    file: &str,
-    what: &str,
-    w: u32,
-    h: u32,
-    found_w: u32,
-    found_h: u32,
-) -> DataError {
-    DataError::field(
-        file,
-        "size",
-        format!("expected {w}x{h} ({what}), found {found_w}x{found_h}"),
-    )
-}
-
 /// Finds and reads the optional depth or semantic file of a frame (`k`: 0 depth, 1 semantic).
 fn sibling_file<'a>(
     files: &'a FileSet,
@@ -408,7 +338,6 @@ fn read_frame(
     })
 }
 
-/// Reads `gt/{state}/...ply`; `None` when the state has no GT mesh files.
 /// Joints and part meshes alone, in the layout of a dataset's `gt/` folder: the ground truth of a
 /// dataset, or a prediction written the same way. `artmesh eval` reads both sides with it.
 #[derive(Debug, Clone, PartialEq, Default)]
@@ -448,25 +377,7 @@ impl GroundTruth {
     }
 }
 
-pub(crate) fn write_ground_truth(
-    joints: Option<&[GtJoint]>,
-    meshes: &[Option<GtMeshes>; 2],
-    out: &mut FileSet,
-) {
-    if let Some(joints) = joints {
-        out.insert(GT_TRANS_PATH.into(), gt::write_trans(joints));
-    }
-    for state in State::ALL {
-        if let Some(m) = &meshes[state.index()] {
-            let ply = |mesh: &TriMesh| mesh.to_ply(PlyFormat::BinaryLittleEndian);
-            out.insert(gt::static_mesh_path(state), ply(&m.static_part));
-            for (i, mesh) in m.movable.iter().enumerate() {
-                out.insert(gt::movable_mesh_path(state, i), ply(mesh));
-            }
-        }
-    }
-}
-
+/// Reads `gt/{state}/...ply`; `None` when the state has no GT mesh files.
 fn read_gt_meshes(files: &FileSet, state: State, errs: &mut Errors) -> Option<GtMeshes> {
     let prefix = format!("gt/{0}/{0}_dynamic_", state.name());
     let mut indexed: BTreeSet<usize> = BTreeSet::new();

@@ -7,9 +7,10 @@
 use glam::Vec3;
 use serde_json::{Value, json};
 
+use super::FileSet;
 use super::error::{DataError, Errors};
 use super::json::{Json, f32_array, f32_value, join};
-use super::ply::TriMesh;
+use super::ply::{PlyFormat, TriMesh};
 use super::{GT_TRANS_PATH, State};
 
 /// Joint type of a movable part.
@@ -216,4 +217,46 @@ pub(crate) fn write_trans(joints: &[GtJoint]) -> Vec<u8> {
 /// Writes a PARIS-style `trans.json` whose `trans_info` is the single joint object.
 pub(crate) fn write_trans_single(joint: &GtJoint) -> Vec<u8> {
     serde_json::to_vec_pretty(&json!({ "trans_info": entry_json(joint) })).unwrap_or_default()
+}
+
+/// Part count implied by the ground-truth joints, the largest part id seen and the GT mesh count: one rule for
+/// reader and writer. With `gt/trans.json` it is 1 + joints; otherwise 1 + the largest id or mesh index.
+pub(crate) fn implied_num_parts(
+    joints: Option<&[GtJoint]>,
+    max_id: Option<i16>,
+    meshes: &[Option<GtMeshes>; 2],
+) -> usize {
+    let max_movable_meshes = meshes
+        .iter()
+        .flatten()
+        .map(|m| m.movable.len())
+        .max()
+        .unwrap_or(0);
+    match joints {
+        Some(j) => 1 + j.len(),
+        None => {
+            let from_ids = max_id.map_or(0, |m| usize::try_from(i32::from(m) + 1).unwrap_or(0));
+            from_ids.max(1 + max_movable_meshes)
+        }
+    }
+}
+
+/// Writes `gt/trans.json` (when there are joints) and each state's part meshes as binary PLY into `out`.
+pub(crate) fn write_ground_truth(
+    joints: Option<&[GtJoint]>,
+    meshes: &[Option<GtMeshes>; 2],
+    out: &mut FileSet,
+) {
+    if let Some(joints) = joints {
+        out.insert(GT_TRANS_PATH.into(), write_trans(joints));
+    }
+    for state in State::ALL {
+        if let Some(m) = &meshes[state.index()] {
+            let ply = |mesh: &TriMesh| mesh.to_ply(PlyFormat::BinaryLittleEndian);
+            out.insert(static_mesh_path(state), ply(&m.static_part));
+            for (i, mesh) in m.movable.iter().enumerate() {
+                out.insert(movable_mesh_path(state, i), ply(mesh));
+            }
+        }
+    }
 }

@@ -21,6 +21,7 @@ mod dataset;
 pub mod degrade;
 mod error;
 pub mod fixture;
+mod frame;
 #[cfg(not(target_arch = "wasm32"))]
 mod fs;
 mod gt;
@@ -37,8 +38,9 @@ use std::collections::BTreeMap;
 
 pub use archive::read_zip;
 pub use camera::{Camera, Intrinsics, look_at};
-pub use dataset::{Dataset, Frame, GroundTruth, SemanticFormat, ViewSet, WriteOptions};
+pub use dataset::{Dataset, GroundTruth, ViewSet};
 pub use error::{DataError, DatasetErrors};
+pub use frame::Frame;
 #[cfg(not(target_arch = "wasm32"))]
 pub use fs::{read_dataset, read_dir, write_dir};
 pub use gt::{GtJoint, GtMeshes, JointKind};
@@ -47,7 +49,7 @@ pub use npy::encode_npy;
 pub use paths::rebase_on_dataset_root;
 pub use ply::{PlyFormat, TriMesh};
 pub use summary::{Summary, ViewSummary};
-pub use writer::DatasetWriter;
+pub use writer::{DatasetWriter, SemanticFormat, WriteOptions};
 
 /// A dataset as bytes: relative path (`'/'` separators, e.g. `start/train/rgba/0000.png`) → file contents.
 pub type FileSet = BTreeMap<String, Vec<u8>>;

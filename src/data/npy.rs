@@ -5,8 +5,11 @@
 //! then the raw array. Sizes claimed by the header are checked against the bytes present before anything
 //! is allocated.
 
+mod header_dict;
+
 use super::error::DataError;
 use super::image_io::PartMap;
+use header_dict::{Py, parse_dict};
 
 const MAGIC: &[u8] = b"\x93NUMPY";
 
@@ -71,158 +74,6 @@ pub fn encode_npy(descr: &str, fortran_order: bool, shape: &[usize], data: &[u8]
     out
 }
 
-/// Value of the Python literal subset used by `.npy` headers.
-#[derive(Debug, Clone, PartialEq)]
-enum Py {
-    Str(String),
-    Bool(bool),
-    Int(u64),
-    Tuple(Vec<Py>),
-    Other(&'static str),
-}
-
-/// Recursive-descent parser for the header dict.
-struct Lit<'a> {
-    s: &'a [u8],
-    pos: usize,
-}
-
-impl<'a> Lit<'a> {
-    fn skip_ws(&mut self) {
-        while self
-            .s
-            .get(self.pos)
-            .is_some_and(|c| c.is_ascii_whitespace())
-        {
-            self.pos += 1;
-        }
-    }
-
-    fn peek(&mut self) -> Option<u8> {
-        self.skip_ws();
-        self.s.get(self.pos).copied()
-    }
-
-    fn expect(&mut self, c: u8) -> Result<(), String> {
-        match self.peek() {
-            Some(x) if x == c => {
-                self.pos += 1;
-                Ok(())
-            }
-            Some(x) => Err(format!(
-                "expected '{}' at offset {}, found '{}'",
-                c as char, self.pos, x as char
-            )),
-            None => Err(format!(
-                "expected '{}', found the end of the header",
-                c as char
-            )),
-        }
-    }
-
-    fn dict(&mut self) -> Result<Vec<(String, Py)>, String> {
-        self.expect(b'{')?;
-        let mut items = Vec::new();
-        loop {
-            if self.peek() == Some(b'}') {
-                self.pos += 1;
-                return Ok(items);
-            }
-            let key = match self.value(0)? {
-                Py::Str(k) => k,
-                other => return Err(format!("expected a string key, found {other:?}")),
-            };
-            self.expect(b':')?;
-            let value = self.value(0)?;
-            items.push((key, value));
-            match self.peek() {
-                Some(b',') => self.pos += 1,
-                Some(b'}') => {}
-                _ => return Err(format!("expected ',' or '}}' at offset {}", self.pos)),
-            }
-        }
-    }
-
-    fn value(&mut self, depth: usize) -> Result<Py, String> {
-        if depth > 8 {
-            return Err("nesting too deep".into());
-        }
-        match self.peek() {
-            Some(q @ (b'\'' | b'"')) => {
-                self.pos += 1;
-                let start = self.pos;
-                while self.s.get(self.pos).is_some_and(|&c| c != q) {
-                    self.pos += 1;
-                }
-                let text = self.s.get(start..self.pos).ok_or("unterminated string")?;
-                self.expect(q)
-                    .map_err(|_| "unterminated string".to_string())?;
-                Ok(Py::Str(String::from_utf8_lossy(text).into_owned()))
-            }
-            Some(open @ (b'(' | b'[')) => {
-                self.pos += 1;
-                let close = if open == b'(' { b')' } else { b']' };
-                let mut items = Vec::new();
-                loop {
-                    if self.peek() == Some(close) {
-                        self.pos += 1;
-                        return Ok(if open == b'(' {
-                            Py::Tuple(items)
-                        } else {
-                            Py::Other("a list")
-                        });
-                    }
-                    items.push(self.value(depth + 1)?);
-                    match self.peek() {
-                        Some(b',') => self.pos += 1,
-                        Some(c) if c == close => {}
-                        _ => {
-                            return Err(format!(
-                                "expected ',' or '{}' at offset {}",
-                                close as char, self.pos
-                            ));
-                        }
-                    }
-                }
-            }
-            Some(b'{') => {
-                self.dict()?;
-                Ok(Py::Other("a dict"))
-            }
-            Some(c) if c.is_ascii_digit() => {
-                let mut n: u64 = 0;
-                while let Some(d) = self.s.get(self.pos).filter(|c| c.is_ascii_digit()) {
-                    n = n
-                        .checked_mul(10)
-                        .and_then(|n| n.checked_add(u64::from(d - b'0')))
-                        .ok_or("integer too large")?;
-                    self.pos += 1;
-                }
-                // Python 2 wrote long integers as `480L`.
-                if self.s.get(self.pos) == Some(&b'L') {
-                    self.pos += 1;
-                }
-                Ok(Py::Int(n))
-            }
-            Some(_) => {
-                let rest = &self.s[self.pos.min(self.s.len())..];
-                for (word, v) in [
-                    ("True", Py::Bool(true)),
-                    ("False", Py::Bool(false)),
-                    ("None", Py::Other("None")),
-                ] {
-                    if rest.starts_with(word.as_bytes()) {
-                        self.pos += word.len();
-                        return Ok(v);
-                    }
-                }
-                Err(format!("unexpected text at offset {}", self.pos))
-            }
-            None => Err("unexpected end of header".into()),
-        }
-    }
-}
-
 /// Parsed header fields.
 struct Header {
     dtype: NpyDtype,
@@ -261,7 +112,34 @@ fn parse_descr(file: &str, descr: &str) -> Result<(NpyDtype, bool), DataError> {
     Ok((dtype, order == b'>'))
 }
 
+/// Parses the header: magic and version, the header dict, and the shape checked against the data present.
 fn parse_header(file: &str, bytes: &[u8]) -> Result<Header, DataError> {
+    let (start, end) = header_span(file, bytes)?;
+    let text = &bytes[start..end];
+    let dict = parse_dict(text)
+        .map_err(|e| DataError::field(file, "header", format!("not a valid header dict: {e}")))?;
+    let (dtype, big_endian, fortran, dims) = header_fields(file, &dict)?;
+    let shape_text = format!(
+        "({})",
+        dims.iter()
+            .map(|d| d.to_string())
+            .collect::<Vec<_>>()
+            .join(", ")
+    );
+    let (h, w) = image_shape(file, &dims, &shape_text)?;
+    check_data_size(file, dtype, (h, w), bytes.len() - end, &shape_text)?;
+    Ok(Header {
+        dtype,
+        big_endian,
+        fortran,
+        height: h as usize,
+        width: w as usize,
+        data_start: end,
+    })
+}
+
+/// Checks the magic and version; returns the byte range of the header dict text.
+fn header_span(file: &str, bytes: &[u8]) -> Result<(usize, usize), DataError> {
     let found: String = bytes
         .iter()
         .take(6)
@@ -308,11 +186,14 @@ fn parse_header(file: &str, bytes: &[u8]) -> Result<Header, DataError> {
                 ),
             )
         })?;
-    let text = &bytes[start..end];
-    let mut lit = Lit { s: text, pos: 0 };
-    let dict = lit
-        .dict()
-        .map_err(|e| DataError::field(file, "header", format!("not a valid header dict: {e}")))?;
+    Ok((start, end))
+}
+
+/// The dict's `descr` (dtype, big-endian), `fortran_order` and `shape` entries.
+fn header_fields(
+    file: &str,
+    dict: &[(String, Py)],
+) -> Result<(NpyDtype, bool, bool, Vec<u64>), DataError> {
     let get = |key: &str| {
         dict.iter()
             .find(|(k, _)| k == key)
@@ -367,14 +248,12 @@ fn parse_header(file: &str, bytes: &[u8]) -> Result<Header, DataError> {
             ));
         }
     };
-    let shape_text = format!(
-        "({})",
-        dims.iter()
-            .map(|d| d.to_string())
-            .collect::<Vec<_>>()
-            .join(", ")
-    );
-    let (h, w) = match dims.as_slice() {
+    Ok((dtype, big_endian, fortran, dims))
+}
+
+/// Image height and width from a shape (H, W) or (H, W, 1), each non-zero and within `u32`.
+fn image_shape(file: &str, dims: &[u64], shape_text: &str) -> Result<(u64, u64), DataError> {
+    let (h, w) = match dims {
         [h, w] | [h, w, 1] => (*h, *w),
         _ => {
             return Err(DataError::field(
@@ -391,42 +270,39 @@ fn parse_header(file: &str, bytes: &[u8]) -> Result<Header, DataError> {
             format!("expected a non-empty image size, found {shape_text}"),
         ));
     }
-    // Check the claimed size against the bytes present before anything is allocated.
-    let have = bytes.len() - end;
+    Ok((h, w))
+}
+
+/// Checks the claimed size against the `have` bytes present, before anything is allocated.
+fn check_data_size(
+    file: &str,
+    dtype: NpyDtype,
+    (h, w): (u64, u64),
+    have: usize,
+    shape_text: &str,
+) -> Result<(), DataError> {
     let need = h
         .checked_mul(w)
         .and_then(|n| n.checked_mul(dtype.size() as u64));
     match need {
-        Some(need) if need == have as u64 => {}
-        Some(need) if need < have as u64 => {
-            return Err(DataError::field(
-                file,
-                "data",
-                format!(
-                    "expected {need} bytes of data for shape {shape_text}, found {have} (extra bytes at the end)"
-                ),
-            ));
-        }
-        _ => {
-            return Err(DataError::field(
-                file,
-                "shape",
-                format!(
-                    "header claims shape {shape_text} of {} ({} bytes), but only {have} bytes of data follow",
-                    dtype.descr(),
-                    need.map_or("more than 2^64".to_string(), |n| n.to_string())
-                ),
-            ));
-        }
+        Some(need) if need == have as u64 => Ok(()),
+        Some(need) if need < have as u64 => Err(DataError::field(
+            file,
+            "data",
+            format!(
+                "expected {need} bytes of data for shape {shape_text}, found {have} (extra bytes at the end)"
+            ),
+        )),
+        _ => Err(DataError::field(
+            file,
+            "shape",
+            format!(
+                "header claims shape {shape_text} of {} ({} bytes), but only {have} bytes of data follow",
+                dtype.descr(),
+                need.map_or("more than 2^64".to_string(), |n| n.to_string())
+            ),
+        )),
     }
-    Ok(Header {
-        dtype,
-        big_endian,
-        fortran,
-        height: h as usize,
-        width: w as usize,
-        data_start: end,
-    })
 }
 
 /// Reads one element as a whole number; `Err` holds the offending value as text.

@@ -231,199 +231,246 @@ impl Body<'_> {
     }
 }
 
+/// The body reader for `encoding`; an ascii body must be text.
+fn body_reader<'a>(file: &str, encoding: Encoding, body: &'a [u8]) -> Result<Body<'a>, DataError> {
+    Ok(match encoding {
+        Encoding::Ascii => Body::Ascii(
+            std::str::from_utf8(body)
+                .map_err(|_| DataError::field(file, "format", "ascii PLY body is not text"))?
+                .split_ascii_whitespace(),
+        ),
+        Encoding::Binary { big_endian } => Body::Binary {
+            data: body,
+            pos: 0,
+            big_endian,
+        },
+    })
+}
+
+/// A GT mesh needs both a vertex and a face element.
+fn check_required_elements(file: &str, elements: &[Element]) -> Result<(), DataError> {
+    if !elements.iter().any(|e| e.name == "vertex") {
+        return Err(DataError::field(
+            file,
+            "element vertex",
+            "missing (expected a vertex element)",
+        ));
+    }
+    if !elements.iter().any(|e| e.name == "face") {
+        return Err(DataError::field(
+            file,
+            "element face",
+            "missing (expected a face element: a GT mesh needs triangles)",
+        ));
+    }
+    Ok(())
+}
+
+/// Rejects element counts the body cannot hold, before anything is allocated.
+fn check_counts_fit(
+    file: &str,
+    encoding: Encoding,
+    elements: &[Element],
+    body_len: usize,
+) -> Result<(), DataError> {
+    // Every entry takes at least one byte (binary: its fixed-size scalars; ascii: a digit or separator),
+    // so a count beyond the body size is a lie.
+    let mut min_total: usize = 0;
+    for el in elements {
+        let per = match encoding {
+            Encoding::Ascii => el.properties.len().max(1),
+            Encoding::Binary { .. } => el
+                .properties
+                .iter()
+                .map(|p| match p {
+                    Property::Scalar(_, t) | Property::List(_, t, _) => t.size(),
+                })
+                .sum::<usize>()
+                .max(1),
+        };
+        min_total = el
+            .count
+            .checked_mul(per)
+            .and_then(|n| n.checked_add(min_total))
+            .unwrap_or(usize::MAX);
+        if min_total > body_len {
+            return Err(DataError::field(
+                file,
+                format!("element {}", el.name),
+                format!(
+                    "truncated: header claims {} entries, but only {} bytes of data follow",
+                    el.count, body_len
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Where an element's data of interest sits: the x, y, z property indices of `vertex`, the index list of
+/// `face` (`None` for other elements, whose entries are read and skipped).
+fn element_layout(
+    file: &str,
+    el: &Element,
+) -> Result<(Option<[usize; 3]>, Option<usize>), DataError> {
+    let field = format!("element {}", el.name);
+    let axis = |n: &str| {
+        el.properties
+            .iter()
+            .position(|p| matches!(p, Property::Scalar(name, _) if name == n))
+    };
+    let xyz = if el.name == "vertex" {
+        match (axis("x"), axis("y"), axis("z")) {
+            (Some(x), Some(y), Some(z)) => Some([x, y, z]),
+            _ => {
+                return Err(DataError::field(
+                    file,
+                    field.as_str(),
+                    "expected properties x, y and z",
+                ));
+            }
+        }
+    } else {
+        None
+    };
+    let face_list = (el.name == "face")
+        .then(|| {
+            el.properties
+                .iter()
+                .position(|p| matches!(p, Property::List(n, _, _) if n == "vertex_indices" || n == "vertex_index"))
+        })
+        .flatten();
+    if el.name == "face" && face_list.is_none() {
+        return Err(DataError::field(
+            file,
+            field.as_str(),
+            "expected a list property vertex_indices (or vertex_index)",
+        ));
+    }
+    Ok((xyz, face_list))
+}
+
+/// Reads every entry of `el`: vertices into `mesh.positions`, faces (fan-triangulated) into
+/// `mesh.triangles`; other elements are consumed and dropped.
+fn read_element(
+    file: &str,
+    el: &Element,
+    reader: &mut Body<'_>,
+    mesh: &mut TriMesh,
+) -> Result<(), DataError> {
+    let field = format!("element {}", el.name);
+    let truncated = |i: usize| {
+        DataError::field(
+            file,
+            field.as_str(),
+            format!(
+                "truncated or malformed: could not read entry {i} of {}",
+                el.count
+            ),
+        )
+    };
+    let (xyz, face_list) = element_layout(file, el)?;
+    if el.name == "vertex" {
+        mesh.positions.reserve(el.count);
+    }
+    let mut polygon = Vec::new();
+    for i in 0..el.count {
+        let mut p = [0.0f64; 3];
+        for (k, prop) in el.properties.iter().enumerate() {
+            match prop {
+                Property::Scalar(_, t) => {
+                    let v = reader.read(*t).ok_or_else(|| truncated(i))?;
+                    if let Some(slot) = xyz.and_then(|xyz| xyz.iter().position(|&a| a == k)) {
+                        p[slot] = v;
+                    }
+                }
+                Property::List(_, count_t, item_t) => {
+                    let n = reader.read(*count_t).ok_or_else(|| truncated(i))?;
+                    let is_faces = face_list == Some(k);
+                    polygon.clear();
+                    for _ in 0..(n.max(0.0) as u64) {
+                        let v = reader.read(*item_t).ok_or_else(|| truncated(i))?;
+                        if is_faces {
+                            if !(v >= 0.0 && v <= f64::from(u32::MAX)) {
+                                return Err(DataError::field(
+                                    file,
+                                    field.as_str(),
+                                    format!(
+                                        "face {i} refers to vertex {v}; expected a non-negative index"
+                                    ),
+                                ));
+                            }
+                            polygon.push(v as u32);
+                        }
+                    }
+                    if is_faces {
+                        if polygon.len() < 3 {
+                            return Err(DataError::field(
+                                file,
+                                field.as_str(),
+                                format!(
+                                    "face {i} has {} vertices; expected at least 3",
+                                    polygon.len()
+                                ),
+                            ));
+                        }
+                        for w in 1..polygon.len() - 1 {
+                            mesh.triangles
+                                .push([polygon[0], polygon[w], polygon[w + 1]]);
+                        }
+                    }
+                }
+            }
+        }
+        if xyz.is_some() {
+            let v = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
+            if !v.is_finite() {
+                return Err(DataError::field(
+                    file,
+                    field.as_str(),
+                    format!("vertex {i} is not finite: {v}"),
+                ));
+            }
+            mesh.positions.push(v);
+        }
+    }
+    Ok(())
+}
+
+/// Every triangle index must name a vertex; checked after reading so the element order does not matter.
+fn check_face_indices(file: &str, mesh: &TriMesh) -> Result<(), DataError> {
+    let n = mesh.positions.len();
+    if let Some((i, t)) = mesh
+        .triangles
+        .iter()
+        .enumerate()
+        .find(|(_, t)| t.iter().any(|&v| v as usize >= n))
+    {
+        return Err(DataError::field(
+            file,
+            "element face",
+            format!(
+                "triangle {i} refers to vertex {}, but there are {n} vertices",
+                t.iter().max().copied().unwrap_or(0)
+            ),
+        ));
+    }
+    Ok(())
+}
+
 impl TriMesh {
     /// Reads a PLY mesh (ascii or binary). `file` names the file in errors.
     pub fn from_ply(file: &str, bytes: &[u8]) -> Result<TriMesh, DataError> {
         let (encoding, elements, body_start) = parse_header(file, bytes)?;
         let body = bytes.get(body_start..).unwrap_or(&[]);
-        let mut reader = match encoding {
-            Encoding::Ascii => Body::Ascii(
-                std::str::from_utf8(body)
-                    .map_err(|_| DataError::field(file, "format", "ascii PLY body is not text"))?
-                    .split_ascii_whitespace(),
-            ),
-            Encoding::Binary { big_endian } => Body::Binary {
-                data: body,
-                pos: 0,
-                big_endian,
-            },
-        };
-        if !elements.iter().any(|e| e.name == "vertex") {
-            return Err(DataError::field(
-                file,
-                "element vertex",
-                "missing (expected a vertex element)",
-            ));
-        }
-        if !elements.iter().any(|e| e.name == "face") {
-            return Err(DataError::field(
-                file,
-                "element face",
-                "missing (expected a face element: a GT mesh needs triangles)",
-            ));
-        }
-        // Every entry takes at least one byte (binary: its fixed-size scalars; ascii: a digit or separator),
-        // so a count beyond the body size is a lie; reject it before allocating.
-        let mut min_total: usize = 0;
-        for el in &elements {
-            let per = match encoding {
-                Encoding::Ascii => el.properties.len().max(1),
-                Encoding::Binary { .. } => el
-                    .properties
-                    .iter()
-                    .map(|p| match p {
-                        Property::Scalar(_, t) | Property::List(_, t, _) => t.size(),
-                    })
-                    .sum::<usize>()
-                    .max(1),
-            };
-            min_total = el
-                .count
-                .checked_mul(per)
-                .and_then(|n| n.checked_add(min_total))
-                .unwrap_or(usize::MAX);
-            if min_total > body.len() {
-                return Err(DataError::field(
-                    file,
-                    format!("element {}", el.name),
-                    format!(
-                        "truncated: header claims {} entries, but only {} bytes of data follow",
-                        el.count,
-                        body.len()
-                    ),
-                ));
-            }
-        }
-
+        let mut reader = body_reader(file, encoding, body)?;
+        check_required_elements(file, &elements)?;
+        check_counts_fit(file, encoding, &elements, body.len())?;
         let mut mesh = TriMesh::default();
-        let mut polygon = Vec::new();
         for el in &elements {
-            let field = format!("element {}", el.name);
-            let truncated = |i: usize| {
-                DataError::field(
-                    file,
-                    field.as_str(),
-                    format!(
-                        "truncated or malformed: could not read entry {i} of {}",
-                        el.count
-                    ),
-                )
-            };
-            let axis = |n: &str| {
-                el.properties
-                    .iter()
-                    .position(|p| matches!(p, Property::Scalar(name, _) if name == n))
-            };
-            let xyz = if el.name == "vertex" {
-                match (axis("x"), axis("y"), axis("z")) {
-                    (Some(x), Some(y), Some(z)) => Some([x, y, z]),
-                    _ => {
-                        return Err(DataError::field(
-                            file,
-                            field.as_str(),
-                            "expected properties x, y and z",
-                        ));
-                    }
-                }
-            } else {
-                None
-            };
-            let face_list = (el.name == "face")
-                .then(|| {
-                    el.properties
-                        .iter()
-                        .position(|p| matches!(p, Property::List(n, _, _) if n == "vertex_indices" || n == "vertex_index"))
-                })
-                .flatten();
-            if el.name == "face" && face_list.is_none() {
-                return Err(DataError::field(
-                    file,
-                    field.as_str(),
-                    "expected a list property vertex_indices (or vertex_index)",
-                ));
-            }
-            if el.name == "vertex" {
-                mesh.positions.reserve(el.count);
-            }
-            for i in 0..el.count {
-                let mut p = [0.0f64; 3];
-                for (k, prop) in el.properties.iter().enumerate() {
-                    match prop {
-                        Property::Scalar(_, t) => {
-                            let v = reader.read(*t).ok_or_else(|| truncated(i))?;
-                            if let Some(slot) = xyz.and_then(|xyz| xyz.iter().position(|&a| a == k))
-                            {
-                                p[slot] = v;
-                            }
-                        }
-                        Property::List(_, count_t, item_t) => {
-                            let n = reader.read(*count_t).ok_or_else(|| truncated(i))?;
-                            let is_faces = face_list == Some(k);
-                            polygon.clear();
-                            for _ in 0..(n.max(0.0) as u64) {
-                                let v = reader.read(*item_t).ok_or_else(|| truncated(i))?;
-                                if is_faces {
-                                    if !(v >= 0.0 && v <= f64::from(u32::MAX)) {
-                                        return Err(DataError::field(
-                                            file,
-                                            field.as_str(),
-                                            format!(
-                                                "face {i} refers to vertex {v}; expected a non-negative index"
-                                            ),
-                                        ));
-                                    }
-                                    polygon.push(v as u32);
-                                }
-                            }
-                            if is_faces {
-                                if polygon.len() < 3 {
-                                    return Err(DataError::field(
-                                        file,
-                                        field.as_str(),
-                                        format!(
-                                            "face {i} has {} vertices; expected at least 3",
-                                            polygon.len()
-                                        ),
-                                    ));
-                                }
-                                for w in 1..polygon.len() - 1 {
-                                    mesh.triangles
-                                        .push([polygon[0], polygon[w], polygon[w + 1]]);
-                                }
-                            }
-                        }
-                    }
-                }
-                if xyz.is_some() {
-                    let v = Vec3::new(p[0] as f32, p[1] as f32, p[2] as f32);
-                    if !v.is_finite() {
-                        return Err(DataError::field(
-                            file,
-                            field.as_str(),
-                            format!("vertex {i} is not finite: {v}"),
-                        ));
-                    }
-                    mesh.positions.push(v);
-                }
-            }
+            read_element(file, el, &mut reader, &mut mesh)?;
         }
-        // Checked after reading so the element order in the file does not matter.
-        let n = mesh.positions.len();
-        if let Some((i, t)) = mesh
-            .triangles
-            .iter()
-            .enumerate()
-            .find(|(_, t)| t.iter().any(|&v| v as usize >= n))
-        {
-            return Err(DataError::field(
-                file,
-                "element face",
-                format!(
-                    "triangle {i} refers to vertex {}, but there are {n} vertices",
-                    t.iter().max().copied().unwrap_or(0)
-                ),
-            ));
-        }
+        check_face_indices(file, &mesh)?;
         Ok(mesh)
     }
 

@@ -8,8 +8,8 @@ use glam::{DMat3, DVec3, Mat4};
 use serde_json::{Map, Value, json};
 
 use super::camera::{Camera, Intrinsics};
-use super::dataset::Frame;
 use super::error::{DataError, Errors};
+use super::frame::Frame;
 use super::json::{self, Json, f32_array, f32_value, optional};
 use super::paths;
 use super::{Split, State};

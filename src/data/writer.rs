@@ -6,15 +6,30 @@
 
 use std::collections::{BTreeMap, BTreeSet};
 
-use super::dataset::{
-    Frame, SemanticFormat, WriteOptions, implied_num_parts, size_error, write_ground_truth,
-};
 use super::error::DataError;
-use super::gt::{GtJoint, GtMeshes};
+use super::frame::{Frame, size_error};
+use super::gt::{GtJoint, GtMeshes, implied_num_parts, write_ground_truth};
 use super::image_io;
 use super::npy;
 use super::transforms::{self, FrameMeta};
 use super::{FileSet, GT_TRANS_PATH, Split, State, transforms_file_name};
+
+/// How [`Dataset::to_files_with`](super::Dataset::to_files_with) writes semantic maps.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum SemanticFormat {
+    /// Our 16-bit PNG (0 = background, k+1 = part k).
+    #[default]
+    Png,
+    /// GaussianArt-style `.npy` of `<i4` part ids (-1 = background).
+    Npy,
+}
+
+/// Options of the writer.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub struct WriteOptions {
+    /// Semantic map encoding.
+    pub semantic: SemanticFormat,
+}
 
 /// What the writer remembers of one view set: frame metadata for its transforms file and the first frame's
 /// image size and channels, which every later frame must match.

@@ -1,387 +1,21 @@
-//! Mesh files from bytes: Wavefront OBJ (+MTL, PNG `map_Kd`), STL (binary or ASCII) and glTF 2.0 (GLB, or
-//! `.gltf` JSON with external or `data:` buffers). Every reader returns [`RenderMesh`]es in the file's frame.
-//!
-//! Untrusted sizes are checked before use (accessor ranges, STL triangle counts, indices), so a corrupt file is
-//! an error, never a panic. Problems that still leave a usable mesh (JPEG textures, which the `image` build
-//! here cannot decode; a missing MTL or texture file; non-triangle glTF primitives) become warnings.
+//! glTF 2.0 reader (GLB or `.gltf` JSON with external or `data:` buffers): walks the default scene's node
+//! tree, reads triangle primitives through bounds-checked accessors, and decodes PNG base-colour textures.
 
 use std::collections::HashMap;
-use std::io::{BufReader, Cursor};
 use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
 use crate::data::{DataError, FileSet, RgbaImage};
+use crate::object::{Material, RenderMesh};
 
-use super::{Material, RenderMesh};
-
-/// Mesh file formats the importer reads.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MeshFormat {
-    /// Wavefront `.obj` (materials from `.mtl`).
-    Obj,
-    /// `.stl`, binary or ASCII.
-    Stl,
-    /// Binary glTF `.glb`.
-    Glb,
-    /// JSON glTF `.gltf`.
-    Gltf,
-}
-
-impl MeshFormat {
-    /// Format from a file name's extension (case-insensitive); `None` for anything else.
-    pub fn from_path(path: &str) -> Option<MeshFormat> {
-        let name = path.rsplit('/').next().unwrap_or(path);
-        let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();
-        match ext.as_str() {
-            "obj" => Some(MeshFormat::Obj),
-            "stl" => Some(MeshFormat::Stl),
-            "glb" => Some(MeshFormat::Glb),
-            "gltf" => Some(MeshFormat::Gltf),
-            _ => None,
-        }
-    }
-}
-
-/// Reads the mesh file `path` (a key of `files`; its format from the extension). Files it refers to (MTL,
-/// textures, glTF buffers) are looked up in `files` relative to its folder. Recoverable problems are pushed to
-/// `warnings`. Errors name `path` (or the referenced file at fault).
-pub fn load_mesh(
-    path: &str,
-    files: &FileSet,
-    warnings: &mut Vec<String>,
-) -> Result<Vec<RenderMesh>, DataError> {
-    let Some(format) = MeshFormat::from_path(path) else {
-        let ext = path
-            .rsplit('/')
-            .next()
-            .and_then(|n| n.rsplit_once('.'))
-            .map_or("(none)", |(_, e)| e);
-        return Err(DataError::file(
-            path,
-            format!(
-                "unsupported mesh format '{ext}': expected .obj, .stl, .glb or .gltf (convert COLLADA .dae and other formats first)"
-            ),
-        ));
-    };
-    let Some(bytes) = files.get(path) else {
-        return Err(DataError::file(path, "mesh file not found in the dataset"));
-    };
-    let meshes = match format {
-        MeshFormat::Obj => read_obj(path, bytes, files, warnings)?,
-        MeshFormat::Stl => read_stl(path, bytes)?,
-        MeshFormat::Glb | MeshFormat::Gltf => read_gltf(path, bytes, files, warnings)?,
-    };
-    if meshes.iter().all(|m| m.indices.is_empty()) {
-        return Err(DataError::file(path, "mesh file holds no triangles"));
-    }
-    Ok(meshes)
-}
-
-/// Folder part of a '/'-separated path, with a trailing '/' (empty for a top-level file).
-fn folder_of(path: &str) -> &str {
-    match path.rfind('/') {
-        Some(i) => &path[..=i],
-        None => "",
-    }
-}
-
-/// Joins `rel` to `folder` (which ends with '/' or is empty), resolving `.` and `..`; `None` if the result
-/// would leave the file-set root or `rel` is absolute.
-pub(super) fn join_relative(folder: &str, rel: &str) -> Option<String> {
-    // Backslashes and ':' (Windows separators and drive letters) would escape the '/'-keyed file set's rules.
-    if rel.starts_with('/') || rel.contains('\\') || rel.contains(':') {
-        return None;
-    }
-    let mut parts: Vec<&str> = folder.split('/').filter(|s| !s.is_empty()).collect();
-    for piece in rel.split('/') {
-        match piece {
-            "" | "." => {}
-            ".." => {
-                parts.pop()?;
-            }
-            p => parts.push(p),
-        }
-    }
-    if parts.is_empty() {
-        return None;
-    }
-    Some(parts.join("/"))
-}
-
-// ---------------------------------------------------------------------------------------------- OBJ
-
-fn read_obj(
-    path: &str,
-    bytes: &[u8],
-    files: &FileSet,
-    warnings: &mut Vec<String>,
-) -> Result<Vec<RenderMesh>, DataError> {
-    let folder = folder_of(path);
-    let options = tobj::LoadOptions {
-        single_index: true,
-        triangulate: true,
-        ignore_points: true,
-        ignore_lines: true,
-    };
-    // The loader closure is `Fn`; collect its notes and the MTL's location through cells.
-    let notes = std::cell::RefCell::new(Vec::<String>::new());
-    let mtl_folder = std::cell::RefCell::new(folder.to_string());
-    let loader = |mtl: &std::path::Path| -> tobj::MTLLoadResult {
-        let name = mtl.to_string_lossy();
-        let Some(key) = join_relative(folder, &name) else {
-            notes.borrow_mut().push(format!(
-                "{path}: material library '{name}' is outside the dataset; using plain colours"
-            ));
-            return Err(tobj::LoadError::OpenFileFailed);
-        };
-        let Some(data) = files.get(&key) else {
-            notes.borrow_mut().push(format!(
-                "{path}: material library '{key}' not found; using plain colours"
-            ));
-            return Err(tobj::LoadError::OpenFileFailed);
-        };
-        *mtl_folder.borrow_mut() = folder_of(&key).to_string();
-        tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(data))).inspect_err(|e| {
-            notes.borrow_mut().push(format!(
-                "{key}: could not read material library ({e}); using plain colours"
-            ));
-        })
-    };
-    let (models, materials) =
-        tobj::load_obj_buf(&mut BufReader::new(Cursor::new(bytes)), &options, loader)
-            .map_err(|e| DataError::file(path, format!("could not read OBJ: {e}")))?;
-    warnings.extend(notes.into_inner());
-    let materials = materials.unwrap_or_default();
-    let tex_folder = mtl_folder.into_inner();
-
-    // Decode each material once, even when many groups use it.
-    let mut decoded: Vec<Material> = Vec::with_capacity(materials.len());
-    for m in &materials {
-        let d = m.diffuse.unwrap_or([0.7, 0.7, 0.7]);
-        let alpha = m.dissolve.unwrap_or(1.0);
-        let texture = m
-            .diffuse_texture
-            .as_deref()
-            .and_then(|t| load_texture_file(path, &tex_folder, t, files, warnings).map(Arc::new));
-        decoded.push(Material {
-            name: Some(m.name.clone()),
-            base_color: [d[0], d[1], d[2], alpha],
-            texture,
-        });
-    }
-
-    let mut out = Vec::with_capacity(models.len());
-    for model in models {
-        let mesh = model.mesh;
-        let n = mesh.positions.len() / 3;
-        let positions: Vec<Vec3> = mesh
-            .positions
-            .chunks_exact(3)
-            .map(|p| Vec3::new(p[0], p[1], p[2]))
-            .collect();
-        let indices = triangles(path, &mesh.indices, n)?;
-        if indices.is_empty() {
-            continue;
-        }
-        let normals = if mesh.normals.len() == mesh.positions.len() {
-            mesh.normals
-                .chunks_exact(3)
-                .map(|v| Vec3::new(v[0], v[1], v[2]).normalize_or_zero())
-                .collect()
-        } else {
-            vertex_normals(&positions, &indices)
-        };
-        let uvs = (mesh.texcoords.len() == 2 * n).then(|| {
-            mesh.texcoords
-                .chunks_exact(2)
-                .map(|t| Vec2::new(t[0], 1.0 - t[1]))
-                .collect()
-        });
-        let colors = (mesh.vertex_color.len() == 3 * n).then(|| {
-            mesh.vertex_color
-                .chunks_exact(3)
-                .map(|c| [c[0], c[1], c[2]])
-                .collect()
-        });
-        let material = mesh
-            .material_id
-            .and_then(|i| decoded.get(i).cloned())
-            .unwrap_or(Material {
-                name: None,
-                ..Material::default()
-            });
-        out.push(RenderMesh {
-            positions,
-            normals,
-            uvs,
-            colors,
-            indices,
-            material,
-        });
-    }
-    Ok(out)
-}
-
-/// Groups a flat index list in threes, checking every index against the vertex count.
-fn triangles(path: &str, flat: &[u32], vertex_count: usize) -> Result<Vec<[u32; 3]>, DataError> {
-    let mut out = Vec::with_capacity(flat.len() / 3);
-    for t in flat.chunks_exact(3) {
-        let tri = [t[0], t[1], t[2]];
-        if let Some(bad) = tri.iter().find(|&&i| i as usize >= vertex_count) {
-            return Err(DataError::file(
-                path,
-                format!(
-                    "triangle refers to vertex {bad}, but the mesh has {vertex_count} vertices"
-                ),
-            ));
-        }
-        out.push(tri);
-    }
-    Ok(out)
-}
-
-/// Area-weighted vertex normals.
-fn vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut normals = vec![Vec3::ZERO; positions.len()];
-    for t in indices {
-        let [a, b, c] = t.map(|i| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
-        let n = (b - a).cross(c - a);
-        for &i in t {
-            if let Some(slot) = normals.get_mut(i as usize) {
-                *slot += n;
-            }
-        }
-    }
-    normals.iter().map(|n| n.normalize_or_zero()).collect()
-}
-
-/// Loads a texture referenced by `referrer`; PNG is decoded, anything else becomes a warning and `None`.
-fn load_texture_file(
-    referrer: &str,
-    folder: &str,
-    name: &str,
-    files: &FileSet,
-    warnings: &mut Vec<String>,
-) -> Option<RgbaImage> {
-    let Some(key) = join_relative(folder, name) else {
-        warnings.push(format!(
-            "{referrer}: texture '{name}' is outside the dataset; using the base colour"
-        ));
-        return None;
-    };
-    let Some(bytes) = files.get(&key) else {
-        warnings.push(format!(
-            "{referrer}: texture '{key}' not found; using the base colour"
-        ));
-        return None;
-    };
-    decode_texture(&key, bytes, warnings)
-}
-
-/// Decodes PNG texture bytes to RGBA; other formats (JPEG: no decoder in this build) give a warning.
-pub(super) fn decode_texture(
-    name: &str,
-    bytes: &[u8],
-    warnings: &mut Vec<String>,
-) -> Option<RgbaImage> {
-    const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
-    if !bytes.starts_with(PNG_MAGIC) {
-        let kind = if bytes.starts_with(&[0xFF, 0xD8]) {
-            "JPEG"
-        } else {
-            "an unknown format"
-        };
-        warnings.push(format!(
-            "{name}: texture is {kind}; only PNG textures are decoded, using the base colour"
-        ));
-        return None;
-    }
-    match image::load_from_memory_with_format(bytes, image::ImageFormat::Png) {
-        Ok(img) => {
-            let rgba = img.to_rgba8();
-            Some(RgbaImage {
-                width: rgba.width(),
-                height: rgba.height(),
-                pixels: rgba.into_raw(),
-            })
-        }
-        Err(e) => {
-            warnings.push(format!(
-                "{name}: could not decode PNG texture ({e}); using the base colour"
-            ));
-            None
-        }
-    }
-}
-
-// ---------------------------------------------------------------------------------------------- STL
-
-fn read_stl(path: &str, bytes: &[u8]) -> Result<Vec<RenderMesh>, DataError> {
-    // Binary STL: 80-byte header, u32 count, 50 bytes per triangle. Check the count against the size first so
-    // a corrupt count cannot trigger a huge allocation. Some binary files start with "solid" too, so only
-    // text that parses as ASCII is treated as ASCII.
-    let is_ascii = bytes.starts_with(b"solid")
-        && bytes
-            .get(..bytes.len().min(512))
-            .is_some_and(|h| h.iter().all(|b| b.is_ascii()));
-    if !is_ascii {
-        let count = bytes
-            .get(80..84)
-            .map(|c| u32::from_le_bytes([c[0], c[1], c[2], c[3]]) as u64)
-            .ok_or_else(|| DataError::file(path, "STL file shorter than its 84-byte header"))?;
-        let need = 84 + 50 * count;
-        if (bytes.len() as u64) < need {
-            return Err(DataError::file(
-                path,
-                format!(
-                    "binary STL declares {count} triangles ({need} bytes), but the file has {} bytes",
-                    bytes.len()
-                ),
-            ));
-        }
-    }
-    let mesh = stl_io::read_stl(&mut Cursor::new(bytes))
-        .map_err(|e| DataError::file(path, format!("could not read STL: {e}")))?;
-    // Split vertices per face: STL models are mostly hard-edged, so flat normals look right.
-    let mut positions = Vec::with_capacity(mesh.faces.len() * 3);
-    let mut normals = Vec::with_capacity(mesh.faces.len() * 3);
-    let mut indices = Vec::with_capacity(mesh.faces.len());
-    for face in &mesh.faces {
-        let mut corners = [Vec3::ZERO; 3];
-        for (corner, &v) in corners.iter_mut().zip(face.vertices.iter()) {
-            let p = mesh.vertices.get(v).ok_or_else(|| {
-                DataError::file(path, format!("triangle refers to missing vertex {v}"))
-            })?;
-            *corner = Vec3::from_array(p.0);
-        }
-        let n = (corners[1] - corners[0])
-            .cross(corners[2] - corners[0])
-            .normalize_or_zero();
-        let base = positions.len() as u32;
-        positions.extend_from_slice(&corners);
-        normals.extend_from_slice(&[n; 3]);
-        indices.push([base, base + 1, base + 2]);
-    }
-    Ok(vec![RenderMesh {
-        positions,
-        normals,
-        uvs: None,
-        colors: None,
-        indices,
-        material: Material {
-            name: None,
-            ..Material::default()
-        },
-    }])
-}
-
-// ---------------------------------------------------------------------------------------------- glTF
+use super::{decode_texture, folder_of, join_relative, triangles, vertex_normals};
 
 /// Nodes nested deeper than this are rejected (guards against cyclic node graphs).
 const MAX_NODE_DEPTH: usize = 64;
 
-fn read_gltf(
+/// Reads a GLB or `.gltf` file; meshes come out in the scene's frame (node transforms applied).
+pub(super) fn read_gltf(
     path: &str,
     bytes: &[u8],
     files: &FileSet,
@@ -417,6 +51,7 @@ fn read_gltf(
     Ok(reader.out)
 }
 
+/// Bytes of every buffer (GLB chunk, external file or data URI), each checked against its declared length.
 fn load_buffers(
     path: &str,
     folder: &str,
@@ -476,7 +111,8 @@ fn load_uri(path: &str, folder: &str, uri: &str, files: &FileSet) -> Result<Vec<
     })
 }
 
-fn percent_decode(s: &str) -> String {
+/// Decodes `%XX` escapes in a URI (invalid escapes are kept as written).
+pub(super) fn percent_decode(s: &str) -> String {
     let bytes = s.as_bytes();
     let mut out = Vec::with_capacity(bytes.len());
     let mut i = 0;
@@ -496,7 +132,8 @@ fn percent_decode(s: &str) -> String {
     String::from_utf8_lossy(&out).into_owned()
 }
 
-fn decode_base64(s: &str) -> Option<Vec<u8>> {
+/// Decodes standard or URL-safe base64 (padding optional); `None` on an invalid character.
+pub(super) fn decode_base64(s: &str) -> Option<Vec<u8>> {
     fn value(c: u8) -> Option<u32> {
         match c {
             b'A'..=b'Z' => Some(u32::from(c - b'A')),
@@ -528,6 +165,7 @@ fn decode_base64(s: &str) -> Option<Vec<u8>> {
     Some(out)
 }
 
+/// Walks one glTF document, collecting its triangle meshes in `out`.
 struct GltfReader<'a> {
     path: &'a str,
     folder: &'a str,
@@ -834,59 +472,5 @@ impl GltfReader<'_> {
 
     fn err(&self, what: &str, message: String) -> DataError {
         DataError::field(self.path, what, message)
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn object_join_relative_stays_inside() {
-        assert_eq!(
-            join_relative("a/b/", "../c.obj").as_deref(),
-            Some("a/c.obj")
-        );
-        assert_eq!(join_relative("", "./x/y.stl").as_deref(), Some("x/y.stl"));
-        assert_eq!(join_relative("a/", "../../c.obj"), None);
-        assert_eq!(join_relative("a/", "/etc/passwd"), None);
-    }
-
-    #[test]
-    fn object_base64_and_percent() {
-        assert_eq!(decode_base64("aGVsbG8=").as_deref(), Some(&b"hello"[..]));
-        assert_eq!(decode_base64("aGk"), Some(b"hi".to_vec()));
-        assert_eq!(decode_base64("a*"), None);
-        assert_eq!(percent_decode("a%20b%zz"), "a b%zz");
-    }
-
-    #[test]
-    fn object_truncated_stl_is_an_error() {
-        let mut bytes = vec![0u8; 84];
-        bytes[80..84].copy_from_slice(&1000u32.to_le_bytes());
-        let e = read_stl("x.stl", &bytes).unwrap_err();
-        assert!(e.message.contains("1000 triangles"), "{e}");
-        assert!(read_stl("x.stl", &[1, 2, 3]).is_err());
-    }
-
-    #[test]
-    fn object_obj_without_mtl_uses_unnamed_material_and_flips_v() {
-        let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
-        let mut files = FileSet::new();
-        files.insert("m/t.obj".into(), obj.to_vec());
-        let mut w = Vec::new();
-        let meshes = load_mesh("m/t.obj", &files, &mut w).unwrap();
-        assert_eq!(meshes.len(), 1);
-        assert_eq!(meshes[0].indices, vec![[0, 1, 2]]);
-        assert_eq!(meshes[0].material.name, None);
-        assert_eq!(meshes[0].uvs.as_ref().unwrap()[0], Vec2::new(0.0, 1.0));
-        assert!((meshes[0].normals[0] - Vec3::Z).length() < 1e-6);
-    }
-
-    #[test]
-    fn object_bad_obj_index_is_an_error_not_a_panic() {
-        let mut files = FileSet::new();
-        files.insert("t.obj".into(), b"v 0 0 0\nf 1 2 3\n".to_vec());
-        assert!(load_mesh("t.obj", &files, &mut Vec::new()).is_err());
     }
 }

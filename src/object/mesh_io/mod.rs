@@ -1,0 +1,260 @@
+//! Mesh files from bytes: Wavefront OBJ (+MTL, PNG `map_Kd`), STL (binary or ASCII) and glTF 2.0 (GLB, or
+//! `.gltf` JSON with external or `data:` buffers). Every reader returns [`RenderMesh`]es in the file's frame.
+//!
+//! Untrusted sizes are checked before use (accessor ranges, STL triangle counts, indices), so a corrupt file is
+//! an error, never a panic. Problems that still leave a usable mesh (JPEG textures, which the `image` build
+//! here cannot decode; a missing MTL or texture file; non-triangle glTF primitives) become warnings.
+
+mod gltf;
+mod obj;
+mod stl;
+
+use glam::Vec3;
+
+use crate::data::{DataError, FileSet, RgbaImage};
+
+use super::RenderMesh;
+
+/// Mesh file formats the importer reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront `.obj` (materials from `.mtl`).
+    Obj,
+    /// `.stl`, binary or ASCII.
+    Stl,
+    /// Binary glTF `.glb`.
+    Glb,
+    /// JSON glTF `.gltf`.
+    Gltf,
+}
+
+impl MeshFormat {
+    /// Format from a file name's extension (case-insensitive); `None` for anything else.
+    pub fn from_path(path: &str) -> Option<MeshFormat> {
+        let name = path.rsplit('/').next().unwrap_or(path);
+        let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();
+        match ext.as_str() {
+            "obj" => Some(MeshFormat::Obj),
+            "stl" => Some(MeshFormat::Stl),
+            "glb" => Some(MeshFormat::Glb),
+            "gltf" => Some(MeshFormat::Gltf),
+            _ => None,
+        }
+    }
+}
+
+/// Reads the mesh file `path` (a key of `files`; its format from the extension). Files it refers to (MTL,
+/// textures, glTF buffers) are looked up in `files` relative to its folder. Recoverable problems are pushed to
+/// `warnings`. Errors name `path` (or the referenced file at fault).
+pub fn load_mesh(
+    path: &str,
+    files: &FileSet,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<RenderMesh>, DataError> {
+    let Some(format) = MeshFormat::from_path(path) else {
+        let ext = path
+            .rsplit('/')
+            .next()
+            .and_then(|n| n.rsplit_once('.'))
+            .map_or("(none)", |(_, e)| e);
+        return Err(DataError::file(
+            path,
+            format!(
+                "unsupported mesh format '{ext}': expected .obj, .stl, .glb or .gltf (convert COLLADA .dae and other formats first)"
+            ),
+        ));
+    };
+    let Some(bytes) = files.get(path) else {
+        return Err(DataError::file(path, "mesh file not found in the dataset"));
+    };
+    let meshes = match format {
+        MeshFormat::Obj => obj::read_obj(path, bytes, files, warnings)?,
+        MeshFormat::Stl => stl::read_stl(path, bytes)?,
+        MeshFormat::Glb | MeshFormat::Gltf => gltf::read_gltf(path, bytes, files, warnings)?,
+    };
+    if meshes.iter().all(|m| m.indices.is_empty()) {
+        return Err(DataError::file(path, "mesh file holds no triangles"));
+    }
+    Ok(meshes)
+}
+
+/// Folder part of a '/'-separated path, with a trailing '/' (empty for a top-level file).
+fn folder_of(path: &str) -> &str {
+    match path.rfind('/') {
+        Some(i) => &path[..=i],
+        None => "",
+    }
+}
+
+/// Joins `rel` to `folder` (which ends with '/' or is empty), resolving `.` and `..`; `None` if the result
+/// would leave the file-set root or `rel` is absolute.
+pub(super) fn join_relative(folder: &str, rel: &str) -> Option<String> {
+    // Backslashes and ':' (Windows separators and drive letters) would escape the '/'-keyed file set's rules.
+    if rel.starts_with('/') || rel.contains('\\') || rel.contains(':') {
+        return None;
+    }
+    let mut parts: Vec<&str> = folder.split('/').filter(|s| !s.is_empty()).collect();
+    for piece in rel.split('/') {
+        match piece {
+            "" | "." => {}
+            ".." => {
+                parts.pop()?;
+            }
+            p => parts.push(p),
+        }
+    }
+    if parts.is_empty() {
+        return None;
+    }
+    Some(parts.join("/"))
+}
+
+/// Groups a flat index list in threes, checking every index against the vertex count.
+fn triangles(path: &str, flat: &[u32], vertex_count: usize) -> Result<Vec<[u32; 3]>, DataError> {
+    let mut out = Vec::with_capacity(flat.len() / 3);
+    for t in flat.chunks_exact(3) {
+        let tri = [t[0], t[1], t[2]];
+        if let Some(bad) = tri.iter().find(|&&i| i as usize >= vertex_count) {
+            return Err(DataError::file(
+                path,
+                format!(
+                    "triangle refers to vertex {bad}, but the mesh has {vertex_count} vertices"
+                ),
+            ));
+        }
+        out.push(tri);
+    }
+    Ok(out)
+}
+
+/// Area-weighted vertex normals.
+fn vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
+    let mut normals = vec![Vec3::ZERO; positions.len()];
+    for t in indices {
+        let [a, b, c] = t.map(|i| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
+        let n = (b - a).cross(c - a);
+        for &i in t {
+            if let Some(slot) = normals.get_mut(i as usize) {
+                *slot += n;
+            }
+        }
+    }
+    normals.iter().map(|n| n.normalize_or_zero()).collect()
+}
+
+/// Loads a texture referenced by `referrer`; PNG is decoded, anything else becomes a warning and `None`.
+fn load_texture_file(
+    referrer: &str,
+    folder: &str,
+    name: &str,
+    files: &FileSet,
+    warnings: &mut Vec<String>,
+) -> Option<RgbaImage> {
+    let Some(key) = join_relative(folder, name) else {
+        warnings.push(format!(
+            "{referrer}: texture '{name}' is outside the dataset; using the base colour"
+        ));
+        return None;
+    };
+    let Some(bytes) = files.get(&key) else {
+        warnings.push(format!(
+            "{referrer}: texture '{key}' not found; using the base colour"
+        ));
+        return None;
+    };
+    decode_texture(&key, bytes, warnings)
+}
+
+/// Decodes PNG texture bytes to RGBA; other formats (JPEG: no decoder in this build) give a warning.
+pub(super) fn decode_texture(
+    name: &str,
+    bytes: &[u8],
+    warnings: &mut Vec<String>,
+) -> Option<RgbaImage> {
+    const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
+    if !bytes.starts_with(PNG_MAGIC) {
+        let kind = if bytes.starts_with(&[0xFF, 0xD8]) {
+            "JPEG"
+        } else {
+            "an unknown format"
+        };
+        warnings.push(format!(
+            "{name}: texture is {kind}; only PNG textures are decoded, using the base colour"
+        ));
+        return None;
+    }
+    match image::load_from_memory_with_format(bytes, image::ImageFormat::Png) {
+        Ok(img) => {
+            let rgba = img.to_rgba8();
+            Some(RgbaImage {
+                width: rgba.width(),
+                height: rgba.height(),
+                pixels: rgba.into_raw(),
+            })
+        }
+        Err(e) => {
+            warnings.push(format!(
+                "{name}: could not decode PNG texture ({e}); using the base colour"
+            ));
+            None
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec2;
+
+    use super::gltf::{decode_base64, percent_decode};
+    use super::stl::read_stl;
+    use super::*;
+
+    #[test]
+    fn object_join_relative_stays_inside() {
+        assert_eq!(
+            join_relative("a/b/", "../c.obj").as_deref(),
+            Some("a/c.obj")
+        );
+        assert_eq!(join_relative("", "./x/y.stl").as_deref(), Some("x/y.stl"));
+        assert_eq!(join_relative("a/", "../../c.obj"), None);
+        assert_eq!(join_relative("a/", "/etc/passwd"), None);
+    }
+
+    #[test]
+    fn object_base64_and_percent() {
+        assert_eq!(decode_base64("aGVsbG8=").as_deref(), Some(&b"hello"[..]));
+        assert_eq!(decode_base64("aGk"), Some(b"hi".to_vec()));
+        assert_eq!(decode_base64("a*"), None);
+        assert_eq!(percent_decode("a%20b%zz"), "a b%zz");
+    }
+
+    #[test]
+    fn object_truncated_stl_is_an_error() {
+        let mut bytes = vec![0u8; 84];
+        bytes[80..84].copy_from_slice(&1000u32.to_le_bytes());
+        let e = read_stl("x.stl", &bytes).unwrap_err();
+        assert!(e.message.contains("1000 triangles"), "{e}");
+        assert!(read_stl("x.stl", &[1, 2, 3]).is_err());
+    }
+
+    #[test]
+    fn object_obj_without_mtl_uses_unnamed_material_and_flips_v() {
+        let obj = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n";
+        let mut files = FileSet::new();
+        files.insert("m/t.obj".into(), obj.to_vec());
+        let mut w = Vec::new();
+        let meshes = load_mesh("m/t.obj", &files, &mut w).unwrap();
+        assert_eq!(meshes.len(), 1);
+        assert_eq!(meshes[0].indices, vec![[0, 1, 2]]);
+        assert_eq!(meshes[0].material.name, None);
+        assert_eq!(meshes[0].uvs.as_ref().unwrap()[0], Vec2::new(0.0, 1.0));
+        assert!((meshes[0].normals[0] - Vec3::Z).length() < 1e-6);
+    }
+
+    #[test]
+    fn object_bad_obj_index_is_an_error_not_a_panic() {
+        let mut files = FileSet::new();
+        files.insert("t.obj".into(), b"v 0 0 0\nf 1 2 3\n".to_vec());
+        assert!(load_mesh("t.obj", &files, &mut Vec::new()).is_err());
+    }
+}
