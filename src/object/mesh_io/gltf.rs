@@ -9,7 +9,7 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 use crate::data::{DataError, FileSet, RgbaImage};
 use crate::object::{Material, RenderMesh};
 
-use super::{decode_texture, folder_of, join_relative, triangles, vertex_normals};
+use super::shared::{decode_texture, folder_of, join_relative, triangles, vertex_normals};
 
 /// Nodes nested deeper than this are rejected (guards against cyclic node graphs).
 const MAX_NODE_DEPTH: usize = 64;

@@ -7,13 +7,13 @@
 
 mod gltf;
 mod obj;
+mod shared;
 mod stl;
 
-use glam::Vec3;
-
-use crate::data::{DataError, FileSet, RgbaImage};
+use crate::data::{DataError, FileSet};
 
 use super::RenderMesh;
+pub(super) use shared::{decode_texture, join_relative};
 
 /// Mesh file formats the importer reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -78,132 +78,11 @@ pub fn load_mesh(
     Ok(meshes)
 }
 
-/// Folder part of a '/'-separated path, with a trailing '/' (empty for a top-level file).
-fn folder_of(path: &str) -> &str {
-    match path.rfind('/') {
-        Some(i) => &path[..=i],
-        None => "",
-    }
-}
-
-/// Joins `rel` to `folder` (which ends with '/' or is empty), resolving `.` and `..`; `None` if the result
-/// would leave the file-set root or `rel` is absolute.
-pub(super) fn join_relative(folder: &str, rel: &str) -> Option<String> {
-    // Backslashes and ':' (Windows separators and drive letters) would escape the '/'-keyed file set's rules.
-    if rel.starts_with('/') || rel.contains('\\') || rel.contains(':') {
-        return None;
-    }
-    let mut parts: Vec<&str> = folder.split('/').filter(|s| !s.is_empty()).collect();
-    for piece in rel.split('/') {
-        match piece {
-            "" | "." => {}
-            ".." => {
-                parts.pop()?;
-            }
-            p => parts.push(p),
-        }
-    }
-    if parts.is_empty() {
-        return None;
-    }
-    Some(parts.join("/"))
-}
-
-/// Groups a flat index list in threes, checking every index against the vertex count.
-fn triangles(path: &str, flat: &[u32], vertex_count: usize) -> Result<Vec<[u32; 3]>, DataError> {
-    let mut out = Vec::with_capacity(flat.len() / 3);
-    for t in flat.chunks_exact(3) {
-        let tri = [t[0], t[1], t[2]];
-        if let Some(bad) = tri.iter().find(|&&i| i as usize >= vertex_count) {
-            return Err(DataError::file(
-                path,
-                format!(
-                    "triangle refers to vertex {bad}, but the mesh has {vertex_count} vertices"
-                ),
-            ));
-        }
-        out.push(tri);
-    }
-    Ok(out)
-}
-
-/// Area-weighted vertex normals.
-fn vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Vec3> {
-    let mut normals = vec![Vec3::ZERO; positions.len()];
-    for t in indices {
-        let [a, b, c] = t.map(|i| positions.get(i as usize).copied().unwrap_or(Vec3::ZERO));
-        let n = (b - a).cross(c - a);
-        for &i in t {
-            if let Some(slot) = normals.get_mut(i as usize) {
-                *slot += n;
-            }
-        }
-    }
-    normals.iter().map(|n| n.normalize_or_zero()).collect()
-}
-
-/// Loads a texture referenced by `referrer`; PNG is decoded, anything else becomes a warning and `None`.
-fn load_texture_file(
-    referrer: &str,
-    folder: &str,
-    name: &str,
-    files: &FileSet,
-    warnings: &mut Vec<String>,
-) -> Option<RgbaImage> {
-    let Some(key) = join_relative(folder, name) else {
-        warnings.push(format!(
-            "{referrer}: texture '{name}' is outside the dataset; using the base colour"
-        ));
-        return None;
-    };
-    let Some(bytes) = files.get(&key) else {
-        warnings.push(format!(
-            "{referrer}: texture '{key}' not found; using the base colour"
-        ));
-        return None;
-    };
-    decode_texture(&key, bytes, warnings)
-}
-
-/// Decodes PNG texture bytes to RGBA; other formats (JPEG: no decoder in this build) give a warning.
-pub(super) fn decode_texture(
-    name: &str,
-    bytes: &[u8],
-    warnings: &mut Vec<String>,
-) -> Option<RgbaImage> {
-    const PNG_MAGIC: &[u8] = b"\x89PNG\r\n\x1a\n";
-    if !bytes.starts_with(PNG_MAGIC) {
-        let kind = if bytes.starts_with(&[0xFF, 0xD8]) {
-            "JPEG"
-        } else {
-            "an unknown format"
-        };
-        warnings.push(format!(
-            "{name}: texture is {kind}; only PNG textures are decoded, using the base colour"
-        ));
-        return None;
-    }
-    match image::load_from_memory_with_format(bytes, image::ImageFormat::Png) {
-        Ok(img) => {
-            let rgba = img.to_rgba8();
-            Some(RgbaImage {
-                width: rgba.width(),
-                height: rgba.height(),
-                pixels: rgba.into_raw(),
-            })
-        }
-        Err(e) => {
-            warnings.push(format!(
-                "{name}: could not decode PNG texture ({e}); using the base colour"
-            ));
-            None
-        }
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use glam::Vec2;
+
+    use glam::Vec3;
 
     use super::gltf::{decode_base64, percent_decode};
     use super::stl::read_stl;

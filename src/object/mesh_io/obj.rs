@@ -9,7 +9,7 @@ use glam::{Vec2, Vec3};
 use crate::data::{DataError, FileSet};
 use crate::object::{Material, RenderMesh};
 
-use super::{folder_of, join_relative, load_texture_file, triangles, vertex_normals};
+use super::shared::{folder_of, join_relative, load_texture_file, triangles, vertex_normals};
 
 /// Reads an OBJ file and the MTL library and textures it names (looked up in `files` next to it).
 pub(super) fn read_obj(

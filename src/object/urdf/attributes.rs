@@ -6,7 +6,7 @@ use roxmltree::Node;
 
 use crate::data::DataError;
 
-use super::{Reader, child};
+use super::reader::{Reader, child};
 
 impl Reader<'_, '_> {
     /// An error at `node` (or its attribute `attr`): field = `path@attr (line N)`.

@@ -9,7 +9,7 @@ use roxmltree::Node;
 use crate::data::DataError;
 use crate::object::{Joint, JointKind, Limit, Link, Mimic};
 
-use super::{Reader, child};
+use super::reader::{Reader, child};
 
 impl Reader<'_, '_> {
     /// One `<joint>` element; its `mimic` is filled in later by `resolve_mimics`.

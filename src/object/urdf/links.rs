@@ -10,7 +10,7 @@ use crate::data::DataError;
 use crate::object::mesh_io::{self, MeshFormat};
 use crate::object::{Geometry, Material, RenderMesh, Visual};
 
-use super::{Reader, child};
+use super::reader::{Reader, child};
 
 impl Reader<'_, '_> {
     /// A `<visual>` or `<collision>` element (collisions keep no material).

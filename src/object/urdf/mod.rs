@@ -13,16 +13,15 @@
 mod attributes;
 mod joints;
 mod links;
+mod reader;
 mod resolve;
 
 use std::collections::HashMap;
-use std::sync::Arc;
-
-use roxmltree::Node;
 
 use crate::data::{DataError, FileSet};
 
-use super::{ArticulatedObject, Joint, Link, Material, RenderMesh};
+use super::{ArticulatedObject, Joint, Link};
+use reader::{Reader, children};
 
 /// Reads the URDF `urdf_path` of `files` and every mesh and texture it refers to.
 pub(super) fn read_urdf(urdf_path: &str, files: &FileSet) -> Result<ArticulatedObject, DataError> {
@@ -114,37 +113,6 @@ pub(super) fn read_urdf(urdf_path: &str, files: &FileSet) -> Result<ArticulatedO
         root,
         warnings: cx.warnings,
     })
-}
-
-/// Child elements of `node` named `tag`.
-fn children<'a, 'input>(
-    node: Node<'a, 'input>,
-    tag: &'static str,
-) -> impl Iterator<Item = Node<'a, 'input>> {
-    node.children()
-        .filter(move |c| c.is_element() && c.tag_name().name() == tag)
-}
-
-/// First child element of `node` named `tag`.
-fn child<'a, 'input>(node: Node<'a, 'input>, tag: &'static str) -> Option<Node<'a, 'input>> {
-    children(node, tag).next()
-}
-/// Reading state for one URDF: the document, where its files are, and what has been loaded so far. Its
-/// methods are spread by concern: `attributes.rs` (numbers, origins, errors), `links.rs` (visuals, geometry,
-/// materials), `resolve.rs` (file references and packages), `joints.rs` (joints, mimics, the link tree).
-struct Reader<'a, 'input> {
-    file: &'a str,
-    doc: &'a roxmltree::Document<'input>,
-    files: &'a FileSet,
-    /// The URDF's folder, with a trailing '/' (empty at the top level).
-    folder: &'a str,
-    /// package name → folder (with trailing '/'), read from `package.xml` files on first use.
-    packages: Option<HashMap<String, Vec<String>>>,
-    /// Loaded mesh files by key, shared between visuals.
-    meshes: HashMap<String, Arc<[RenderMesh]>>,
-    /// Robot-level materials by name.
-    materials: HashMap<String, Material>,
-    warnings: Vec<String>,
 }
 
 #[cfg(test)]

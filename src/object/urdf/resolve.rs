@@ -8,7 +8,7 @@ use roxmltree::Node;
 use crate::data::{DataError, FileSet};
 use crate::object::mesh_io::join_relative;
 
-use super::{Reader, child};
+use super::reader::{Reader, child};
 
 impl Reader<'_, '_> {
     /// Resolves a URDF file reference to a key of the file set.
