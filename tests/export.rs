@@ -281,7 +281,7 @@ fn fitted_twin_exports_follow_the_fitted_motions_in_the_simulators() {
         4,
         &|_| {},
         &|_| {},
-        &artmesh::fit::object::FitConfig::preset(artmesh::fit::reconstruct::Preset::Tiny),
+        &artmesh::fit::object::FitConfig::preset(artmesh::fit::preset::Preset::Tiny),
     ))
     .unwrap();
     let twin = Twin::from_fit(&fit, "cabinet").unwrap();

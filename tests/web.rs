@@ -296,7 +296,7 @@ async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
         1005,
         &|_| {},
         &|_| {},
-        &artmesh::fit::object::FitConfig::preset(artmesh::fit::reconstruct::Preset::Tiny),
+        &artmesh::fit::object::FitConfig::preset(artmesh::fit::preset::Preset::Tiny),
     )
     .await
     .unwrap();

@@ -1,4 +1,4 @@
-//! Chamfer distance between part meshes, in the two conventions of DESIGN.md §7.
+//! Chamfer distance between part meshes, in the two conventions of docs/design.md §7.
 //!
 //! Each mesh is sampled with `samples` area-weighted surface points (seeded, deterministic on every target);
 //! nearest neighbours are found among the other mesh's samples with a k-d tree, as the peers do with their

@@ -1,6 +1,6 @@
 //! Mesh quality of a reconstruction, per state and part: what makes a mesh simulation-ready
 //! (one connected piece per part, few boundary edges, no non-manifold edges, no face spanning two
-//! parts) and how close it is to the ground truth (Chamfer in both conventions of DESIGN.md §7).
+//! parts) and how close it is to the ground truth (Chamfer in both conventions of docs/design.md §7).
 
 use serde::Serialize;
 
@@ -52,7 +52,7 @@ pub struct StateQuality {
 /// The report of a whole reconstruction.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct ReconstructionReport {
-    pub preset: crate::fit::reconstruct::Preset,
+    pub preset: crate::fit::preset::Preset,
     pub remesh: crate::fit::reconstruct::RemeshMode,
     pub num_parts: usize,
     pub states: Vec<StateQuality>,

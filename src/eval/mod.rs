@@ -1,4 +1,4 @@
-//! Evaluation: the metrics of DESIGN.md §7, computed exactly as the peers (PARIS, ArtGS, the ArtMesh paper)
+//! Evaluation: the metrics of docs/design.md §7, computed exactly as the peers (PARIS, ArtGS, the ArtMesh paper)
 //! compute them, plus Chamfer in true units.
 //!
 //! - [`joints`]: Axis Ang (°), Axis Pos (0.1 m, revolute only, a real line-to-line distance that handles

@@ -1,4 +1,4 @@
-//! Exports of a fitted twin that simulators and viewers load as they are (DESIGN.md §8).
+//! Exports of a fitted twin that simulators and viewers load as they are (docs/design.md §8).
 //!
 //! - [`twin`]: the fit (or a ground truth) as an [`ArticulatedObject`](crate::object::ArticulatedObject):
 //!   base link = part 0, one link and one revolute/prismatic joint per movable part.

@@ -1,7 +1,7 @@
 //! The digital twin the exports describe: one coloured mesh per part in the start state and one
 //! joint per movable part, turned into an [`ArticulatedObject`] that the URDF and GLB writers take.
 //!
-//! Conventions (DESIGN.md §8):
+//! Conventions (docs/design.md §8):
 //! - Link `base` is part 0 and the root; link `part_k` hangs from it by joint `joint_k`.
 //! - The start state is the rest pose: every joint is 0 there and `motion` (radians / metres) at
 //!   the end; limits span both, `[min(0, motion), max(0, motion)]`. A joint with no motion at all

@@ -115,3 +115,38 @@ pub async fn fit_object(
         articulation,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn budget_overrides_reach_both_phases_and_none_keeps_the_preset() {
+        for preset in Preset::ALL {
+            assert_eq!(
+                FitConfig::budgeted(preset, &BudgetOverrides::default()),
+                FitConfig::preset(preset)
+            );
+        }
+        let overrides = BudgetOverrides {
+            max_size: Some(96),
+            max_views: Some(40),
+            articulation_iterations: Some(7),
+            ..BudgetOverrides::default()
+        };
+        let config = FitConfig::budgeted(Preset::Fast, &overrides);
+        assert_eq!(
+            (
+                config.reconstruction.max_size,
+                config.reconstruction.max_views
+            ),
+            (96, 40)
+        );
+        assert_eq!(config.articulation.iterations, 7);
+        let fast = FitConfig::preset(Preset::Fast);
+        assert_eq!(
+            config.reconstruction.fit.iterations,
+            fast.reconstruction.fit.iterations
+        );
+    }
+}

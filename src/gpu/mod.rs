@@ -5,7 +5,7 @@
 //! [`fma_peak`] measures the adapter's achievable f32 FMA rate, the denominator of benchmark
 //! efficiency figures.
 //!
-//! Every kernel obeys the portability rules of DESIGN.md §3 so the same WGSL runs on lavapipe,
+//! Every kernel obeys the portability rules of docs/design.md §3 so the same WGSL runs on lavapipe,
 //! on SwiftShader inside Chromium, and on real GPUs: ≤ 256 invocations per workgroup, ≤ 8 storage
 //! buffers per stage, no float atomics, dispatches tiled in 2-D past the per-dimension limit.
 

@@ -1,5 +1,5 @@
 //! Part-aware restricted Delaunay remeshing (paper §3.1, "Part-aware restricted Delaunay
-//! remeshing"; DESIGN.md §5). `spade` triangulates in 2-D only, so the restricted Delaunay
+//! remeshing"; docs/design.md §5). `spade` triangulates in 2-D only, so the restricted Delaunay
 //! triangulation of a part's surface is approximated the localised way (Gopi et al. 2000): each
 //! vertex takes its k nearest same-part neighbours whose normals agree with its own, projects them
 //! on its tangent plane, triangulates them there and proposes the triangles of its own umbrella;

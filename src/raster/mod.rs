@@ -1,4 +1,4 @@
-//! The differentiable soft mesh rasterizer (MeshSplatting-style, DESIGN.md §4; paper §3.1
+//! The differentiable soft mesh rasterizer (MeshSplatting-style, docs/design.md §4; paper §3.1
 //! "Differentiable mesh rendering"): the mesh field's faces are projected, binned into 8×8
 //! tiles with the GPU radix sort, and alpha-composited front to back with the triangle window
 //! φ = ReLU(L(p)/L(s))^γ; colour, depth and part logits use perspective-correct barycentrics.

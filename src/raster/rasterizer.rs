@@ -1,4 +1,4 @@
-//! Forward and backward orchestration of the differentiable mesh rasterizer (DESIGN.md §4):
+//! Forward and backward orchestration of the differentiable mesh rasterizer (docs/design.md §4):
 //! SH colours → projection and culling → tile binning with the GPU radix sort → per-tile
 //! front-to-back compositing; backward: per-tile replay into per-(face, tile) gradients →
 //! per-face chain rule → per-vertex gather → SH backward. No float atomics anywhere.

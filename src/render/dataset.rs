@@ -6,7 +6,7 @@
 //! dataset layout of `data` with `gt/trans.json` and per-part GT meshes of both states. Frames are encoded and
 //! handed to a sink as they are rendered, so memory stays at one frame whatever the view count.
 //!
-//! Ground truth (DESIGN.md §2): one joint per movable part in part order, axis point `o` and direction `d` in
+//! Ground truth (docs/design.md §2): one joint per movable part in part order, axis point `o` and direction `d` in
 //! world coordinates, `l` / `r` the joint values at start / end (degrees for revolute and continuous joints,
 //! metres for prismatic ones). Objects the part model cannot describe are refused with a clear
 //! [`ObjectProblem`]: nothing moves, a movable part hanging on another movable part, a movable part without

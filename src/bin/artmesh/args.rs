@@ -2,7 +2,8 @@
 //! preset budgets, and the GPU context and JSON output every command uses.
 
 use artmesh::fit::object::FitConfig;
-use artmesh::fit::reconstruct::{Preset, ReconstructionConfig, RemeshMode};
+use artmesh::fit::preset::{BudgetOverrides, Preset};
+use artmesh::fit::reconstruct::{ReconstructionConfig, RemeshMode};
 use artmesh::gpu::GpuContext;
 use artmesh::render::RenderSpec;
 
@@ -76,15 +77,43 @@ impl CaptureArgs {
     }
 }
 
-/// Overrides of a preset's budget shared by `fit` and `demo` (flattened into both): the place
-/// for options such as the working size, views per state or iteration counts. None yet.
+/// Overrides of a preset's budget shared by `fit` and `demo` (flattened into both), so a user
+/// with a real GPU can ask for more than `fast` without going to `paper`.
 #[derive(clap::Args)]
-pub struct BudgetArgs {}
+pub struct BudgetArgs {
+    /// Override the preset's working image size: frames with a longer side above this many
+    /// pixels are downsampled by an integer factor (0: full resolution).
+    #[arg(long)]
+    max_size: Option<u32>,
+    /// Override the preset's training views per state, evenly spaced (0: all).
+    #[arg(long)]
+    max_views: Option<usize>,
+    /// Override the preset's reconstruction steps per state.
+    #[arg(long)]
+    reconstruction_iterations: Option<u32>,
+    /// Override the preset's fixed-topology recovery steps per state.
+    #[arg(long)]
+    recovery_iterations: Option<u32>,
+    /// Override the preset's face cap for densification.
+    #[arg(long)]
+    max_faces: Option<usize>,
+    /// Override the preset's articulation steps.
+    #[arg(long)]
+    articulation_iterations: Option<u32>,
+}
 
 impl BudgetArgs {
     /// Both phases' settings of the named preset, with these overrides applied.
     pub fn fit_config(&self, preset: &str) -> Result<FitConfig, String> {
-        fit_config(preset)
+        let overrides = BudgetOverrides {
+            max_size: self.max_size,
+            max_views: self.max_views,
+            reconstruction_iterations: self.reconstruction_iterations,
+            recovery_iterations: self.recovery_iterations,
+            max_faces: self.max_faces,
+            articulation_iterations: self.articulation_iterations,
+        };
+        Ok(FitConfig::budgeted(Preset::parse(preset)?, &overrides))
     }
 }
 

@@ -3,8 +3,8 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use artmesh::data;
-use artmesh::synth::{Category, SynthParams, generate};
+use artmesh::pipeline::{self, demo};
+use artmesh::synth::Category;
 
 use crate::args::{BudgetArgs, context, to_json};
 use crate::capture;
@@ -52,42 +52,26 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
     };
     let (parts, seed) = (args.parts, args.seed);
     let category = Category::parse(&args.category)?;
-    let object = generate(&SynthParams {
-        category,
-        movable_parts: Some(usize::from(parts)),
-        seed,
-    })?;
+    let object =
+        demo::demo_object(category, usize::from(parts), seed).map_err(|e| e.to_string())?;
     let config = args.budget.fit_config(&args.preset)?;
-    // Captured as a user's dataset would be: the fit reads its working size, and
-    // its joints come from the full-resolution depth and part maps (at 64² those
-    // are too coarse: the demo cabinet's axes came out 20.9° off) and are judged
-    // on the test views.
-    let mut spec = config.demo_capture(seed);
-    spec.width = (4 * spec.width).min(512);
-    spec.height = spec.width;
-    spec.test_views = 4;
+    let spec = config.full_demo_capture(seed);
     let (size, views) = (spec.width, spec.train_views);
     let ctx = context()?;
     eprintln!(
         "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state",
         object.name, parts
     );
-    let dataset = pollster::block_on(artmesh::render::capture_dataset(
+    let input = pollster::block_on(demo::capture_demo(
         &ctx,
         &object,
+        category,
         &spec,
         &mut |_| {},
     ))
-    .map_err(|e| format!("{}: {e}", object.name))?;
-    let files = dataset.to_files().map_err(|e| e.to_string())?;
-    data::write_dir(&files, &out.join("dataset")).map_err(|e| e.to_string())?;
-    let report = fit_and_write(
-        &dataset,
-        &config,
-        &out.join("fit"),
-        &object.name,
-        category.name(),
-    )?;
+    .map_err(|e| e.to_string())?;
+    pipeline::write_dataset(&input.dataset, &out.join("dataset")).map_err(|e| e.to_string())?;
+    let report = fit_and_write(&input, &config, &out.join("fit"))?;
     out!("{}", to_json(&report)?);
     eprintln!(
         "demo: dataset in {0}/dataset, fit in {0}/fit",

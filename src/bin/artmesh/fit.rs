@@ -4,13 +4,15 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use artmesh::data::{self, Dataset};
+use artmesh::data;
 use artmesh::export::FitFolder;
 use artmesh::fit::articulate::{Ablation, GeometryUse};
-use artmesh::fit::object::{FitConfig, fit_object};
-use artmesh::fit::reconstruct::Progress;
+use artmesh::fit::object::FitConfig;
+use artmesh::fit::observer::Progress;
+use artmesh::fit::reconstruct::RemeshMode;
+use artmesh::pipeline::{self, FitInput};
 
-use crate::args::{BudgetArgs, context, reconstruction_config, to_json};
+use crate::args::{BudgetArgs, context, to_json};
 use crate::{capture, progress};
 
 /// `artmesh fit`'s arguments.
@@ -30,9 +32,6 @@ pub struct FitArgs {
     /// part-aware (the paper) or global remeshing (ablation).
     #[arg(long, default_value = "part-aware", value_parser = ["part-aware", "global"])]
     remesh: String,
-    /// Override the preset's articulation steps.
-    #[arg(long)]
-    articulation_iterations: Option<u32>,
     /// How the joints use the dataset's full-resolution depth and part maps: settle (joints
     /// the measurements settle skip the photometric stages), seed (they seed every part's
     /// photometric stages), off (the paper's method) [default: settle; off for paper].
@@ -45,21 +44,16 @@ pub struct FitArgs {
 /// `artmesh fit`: the preset with the options, fitted to the dataset into a fresh folder.
 pub fn run(args: FitArgs) -> Result<ExitCode, String> {
     let mut config = args.budget.fit_config(&args.preset)?;
-    config.reconstruction = reconstruction_config(&args.preset, &args.remesh)?;
-    config.articulation.ablation = Ablation::parse(&args.ablation)?;
-    if let Some(n) = args.articulation_iterations {
-        config.articulation.iterations = n;
+    if args.remesh == "global" {
+        config.reconstruction.remesh = RemeshMode::Global;
     }
+    config.articulation.ablation = Ablation::parse(&args.ablation)?;
     if let Some(g) = args.geometry {
         config.articulation.geometry = GeometryUse::parse(&g)?;
     }
     capture::fresh_folder(&args.out)?;
-    let root = &args.dataset;
-    let dataset = data::read_dataset(root)?;
-    let id = root
-        .file_name()
-        .map_or("object".into(), |n| n.to_string_lossy().into_owned());
-    let report = fit_and_write(&dataset, &config, &args.out, &id, "unknown")?;
+    let input = pipeline::read_dataset(&args.dataset).map_err(|e| e.to_string())?;
+    let report = fit_and_write(&input, &config, &args.out)?;
     out!("{}", to_json(&report)?);
     Ok(ExitCode::SUCCESS)
 }
@@ -67,28 +61,27 @@ pub fn run(args: FitArgs) -> Result<ExitCode, String> {
 /// Fits `dataset` with a progress bar on stderr, writes joints.json, gt/ and report.json
 /// under `out` (a fresh folder), prints the joints and metrics, and returns the report.
 pub fn fit_and_write(
-    dataset: &Dataset,
+    input: &FitInput,
     config: &FitConfig,
     out: &Path,
-    id: &str,
-    category: &str,
 ) -> Result<serde_json::Value, String> {
     let ctx = context()?;
-    let start = std::time::Instant::now();
     let mut bar = progress::Bar::new("fit");
-    let fit = pollster::block_on(fit_object(&ctx, dataset, config, &mut |p: &Progress| {
-        bar.show(p)
-    }))
-    .map_err(|e| format!("{id}: {e}"))?;
+    let run = pollster::block_on(pipeline::fit_and_export(
+        &ctx,
+        input,
+        config,
+        &mut |p: &Progress| bar.show(p),
+    ))
+    .map_err(|e| e.to_string())?;
     bar.finish();
-    let seconds = start.elapsed().as_secs_f64();
-    let folder = FitFolder::build(&fit, dataset, config, id, category, seconds)?;
-    for w in &fit.articulation.warnings {
+    for w in &run.fit.articulation.warnings {
         eprintln!("fit: warning: {w}");
     }
+    let (folder, seconds) = (run.folder, run.seconds);
     log_folder(&folder);
     let meshes = folder.files.keys().filter(|p| p.ends_with(".ply")).count();
-    data::write_dir(&folder.files, out).map_err(|e| e.to_string())?;
+    pipeline::write_fit_folder(&folder, out).map_err(|e| e.to_string())?;
     eprintln!(
         "fit: {seconds:.0} s; wrote joints.json, report.json, gt/ ({meshes} part meshes), the twin as {} \
          (+ meshes), {} and {} (all of it for download) to {}",

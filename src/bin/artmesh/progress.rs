@@ -3,7 +3,7 @@
 
 use std::io::{IsTerminal, Write};
 
-use artmesh::fit::reconstruct::{Phase, Progress};
+use artmesh::fit::observer::{Phase, Progress};
 
 /// Draws [`Progress`] events.
 pub struct Bar {

@@ -5,7 +5,8 @@ use std::process::ExitCode;
 
 use artmesh::data;
 use artmesh::eval;
-use artmesh::fit::reconstruct::{Progress, ReconstructionConfig};
+use artmesh::fit::observer::Progress;
+use artmesh::fit::reconstruct::ReconstructionConfig;
 
 use crate::args::{context, reconstruction_config, to_json};
 use crate::{capture, progress};

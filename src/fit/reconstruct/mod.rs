@@ -1,4 +1,4 @@
-//! The reconstruction phase (paper §3.1, DESIGN.md §5), run independently per articulation
+//! The reconstruction phase (paper §3.1, docs/design.md §5), run independently per articulation
 //! state:
 //!
 //! 1. **initialise** a triangle soup from the depth maps ([`super::init`]);

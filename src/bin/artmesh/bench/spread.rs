@@ -8,11 +8,12 @@ use artmesh::data::{Dataset, GtJoint, JointKind, read_dataset};
 use artmesh::eval::joints::{
     JointPairMetrics, axis_angle_deg, axis_line_distance, match_joints, motion_error,
 };
-use artmesh::fit::articulate::{ArticulationConfig, articulate};
 use artmesh::export::JointRecord;
+use artmesh::fit::articulate::{ArticulationConfig, articulate};
 use artmesh::fit::object::{FitConfig, ObjectFit};
 use artmesh::fit::observer::Unobserved;
-use artmesh::fit::reconstruct::{Preset, reconstruct};
+use artmesh::fit::preset::Preset;
+use artmesh::fit::reconstruct::reconstruct;
 use artmesh::gpu::{AdapterReport, GpuContext};
 use serde::Serialize;
 
