@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # The README's main-job command: `artmesh demo` on the built-in default object (a procedural
 # StorageFurniture cabinet with a drawer and a door, seed 4). It captures the object as a two-state
-# RGB-D dataset with part maps and ground truth (64x64, 12 views per state), fits it with the `fast`
+# RGB-D dataset with part maps and ground truth (256x256, 12 train + 4 test views per state), fits it with the `fast`
 # preset (reconstruction of both states, part-aware remeshing, articulation with the joint-type
 # bake-off), scores it against the ground truth and writes dataset, joints.json, part meshes and
 # report.json to a new folder. Usage: scripts/demo.sh [OUTPUT_DIR]

@@ -18,7 +18,7 @@ import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
-// the browser) asserts the issue's 0.5° / 5 mm (README "Browser app").
+// the browser) asserts the issue's 0.5° / 5 mm (docs/results.md, "Browser vs native").
 const parityPreset = process.env.ARTMESH_PARITY_PRESET ?? "tiny";
 const parityMinutes = parityPreset === "tiny" ? 10 : 50;
 // The whole run's limit, the parity fit's plus the other steps'.

@@ -131,7 +131,7 @@ pub struct ArticulationConfig {
     /// Whether the refined joints' magnitudes are registered along their axes
     /// ([`register_along_axis`](crate::articulation::axis_registration::register_along_axis)).
     /// On the fast laptop it took the motion 0.51° → 0.15° from the truth and the
-    /// browser-vs-native gap 0.84° → 0.28° (README "Browser app").
+    /// browser-vs-native gap 0.84° → 0.28° (docs/results.md, "Browser vs native").
     pub register_magnitude: bool,
     /// How the measured part surfaces are used.
     pub geometry: GeometryUse,
@@ -165,8 +165,8 @@ impl ArticulationConfig {
     /// `tiny` and `fast` train at a quarter of the paper's rates and refine on every view: with
     /// one view per step and the paper's rates, changes that should not matter (the SSIM weight
     /// × (1 + 1e-6), SwiftShader's rounding instead of lavapipe's) moved the fast laptop's axis
-    /// by up to 1.4° and its motion by 2.3°; now by 0.13° and 0.26° (`bench spread`, README
-    /// "Browser app"), at about three times the fit's time. Keeping the paper's rates for the
+    /// by up to 1.4° and its motion by 2.3°; now by 0.13° and 0.26° (`bench spread`, docs/results.md,
+    /// "Browser vs native"), at about three times the fit's time. Keeping the paper's rates for the
     /// candidates brought that back to 2.1°. `paper` keeps the paper's 20 000 single-view steps
     /// at full rates (every one of 100 views per step would cost 100×).
     pub fn preset(preset: Preset) -> Self {
@@ -182,7 +182,7 @@ impl ArticulationConfig {
             Preset::Fast => 20,
             Preset::Paper => 200,
         };
-        // The axis registration is measured at tiny and fast only (README "Browser app"):
+        // The axis registration is measured at tiny and fast only (docs/results.md, "Browser vs native"):
         // `paper` stays the paper's method.
         let (refine_views, rate_factor, register_magnitude) = match preset {
             Preset::Tiny | Preset::Fast => (RefineViews::All, 0.25, true),
