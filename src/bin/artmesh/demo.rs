@@ -51,12 +51,13 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
             .expect("some folder name is free"),
     };
     let (parts, seed) = (args.parts, args.seed);
-    let category = Category::parse(&args.category)?;
+    let category = Category::parse(&args.category).map_err(|e| e.to_string())?;
     let object = generate(&SynthParams {
         category,
         movable_parts: Some(usize::from(parts)),
         seed,
-    })?;
+    })
+    .map_err(|e| e.to_string())?;
     let config = args.budget.fit_config(&args.preset)?;
     // Captured as a user's dataset would be: the fit reads its working size, and
     // its joints come from the full-resolution depth and part maps (at 64² those

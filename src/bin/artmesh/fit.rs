@@ -46,16 +46,16 @@ pub struct FitArgs {
 pub fn run(args: FitArgs) -> Result<ExitCode, String> {
     let mut config = args.budget.fit_config(&args.preset)?;
     config.reconstruction = reconstruction_config(&args.preset, &args.remesh)?;
-    config.articulation.ablation = Ablation::parse(&args.ablation)?;
+    config.articulation.ablation = Ablation::parse(&args.ablation).map_err(|e| e.to_string())?;
     if let Some(n) = args.articulation_iterations {
         config.articulation.iterations = n;
     }
     if let Some(g) = args.geometry {
-        config.articulation.geometry = GeometryUse::parse(&g)?;
+        config.articulation.geometry = GeometryUse::parse(&g).map_err(|e| e.to_string())?;
     }
     capture::fresh_folder(&args.out)?;
     let root = &args.dataset;
-    let dataset = data::read_dataset(root)?;
+    let dataset = data::read_dataset(root).map_err(|e| e.to_string())?;
     let id = root
         .file_name()
         .map_or("object".into(), |n| n.to_string_lossy().into_owned());
@@ -82,7 +82,8 @@ pub fn fit_and_write(
     .map_err(|e| format!("{id}: {e}"))?;
     bar.finish();
     let seconds = start.elapsed().as_secs_f64();
-    let folder = FitFolder::build(&fit, dataset, config, id, category, seconds)?;
+    let folder = FitFolder::build(&fit, dataset, config, id, category, seconds)
+        .map_err(|e| e.to_string())?;
     for w in &fit.articulation.warnings {
         eprintln!("fit: warning: {w}");
     }

@@ -8,8 +8,8 @@ use artmesh::data::{Dataset, GtJoint, JointKind, read_dataset};
 use artmesh::eval::joints::{
     JointPairMetrics, axis_angle_deg, axis_line_distance, match_joints, motion_error,
 };
-use artmesh::fit::articulate::{ArticulationConfig, articulate};
 use artmesh::export::JointRecord;
+use artmesh::fit::articulate::{ArticulationConfig, articulate};
 use artmesh::fit::object::{FitConfig, ObjectFit};
 use artmesh::fit::observer::Unobserved;
 use artmesh::fit::reconstruct::{Preset, reconstruct};
@@ -42,7 +42,7 @@ pub struct SpreadArgs {
 pub fn run(args: &SpreadArgs) -> Result<String, String> {
     let config = fit_config(&args.preset)?;
     let change = SpreadChange::parse(&args.vary)?;
-    let dataset = read_dataset(&args.dataset)?;
+    let dataset = read_dataset(&args.dataset).map_err(|e| e.to_string())?;
     let ctx = context()?;
     let runs = args.runs as usize;
     let report = spread(
