@@ -157,7 +157,8 @@ fn odd_data_gives_warnings_or_clear_errors_and_no_panic() {
         },
         &tiny(),
     ))
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     println!("no depth: {err}");
     assert!(err.contains("depth") && err.contains("end"), "{err}");
 }
@@ -297,7 +298,8 @@ fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
         },
         &tiny(),
     ))
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     println!("unseen: {err}");
     assert!(
         err.contains("part(s) 2 appear in no training view"),

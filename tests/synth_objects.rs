@@ -82,7 +82,8 @@ fn unsupported_part_counts_are_clear_errors() {
         movable_parts: Some(3),
         seed: 0,
     })
-    .unwrap_err();
+    .unwrap_err()
+    .to_string();
     assert!(err.contains("Laptop") && err.contains('3'), "{err}");
 }
 

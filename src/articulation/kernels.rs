@@ -228,10 +228,40 @@ impl MovedMesh {
     }
 }
 
+/// How the GPU motion kernels disagree with the CPU ([`check_against_cpu`]).
+#[derive(Debug, thiserror::Error)]
+pub enum KernelMismatch {
+    /// A GPU call failed.
+    #[error(transparent)]
+    Gpu(#[from] GpuError),
+    /// A moved vertex is off by more than 1e-5 m.
+    #[error("vertex {vertex} moved to {got}, expected {want}")]
+    Position {
+        /// Index of the vertex.
+        vertex: usize,
+        /// Where the GPU moved it.
+        got: DVec3,
+        /// Where the CPU moved it.
+        want: DVec3,
+    },
+    /// A part's reduced sums differ beyond 1e-4 relative (or count differently).
+    #[error("part {part}: GPU sums {got:?} differ from the CPU's {want:?} (max error {error})")]
+    Sums {
+        /// The part.
+        part: usize,
+        /// The GPU's sums.
+        got: PartSums,
+        /// The CPU's sums.
+        want: PartSums,
+        /// The largest absolute difference.
+        error: f64,
+    },
+}
+
 /// Moves a random mesh with random motions and reduces random gradients on the GPU, and compares
 /// both with the CPU (f64): the positions to 1e-5 m, the sums to 1e-4 relative. Shared by the
 /// native and browser tests.
-pub async fn check_against_cpu(ctx: &GpuContext) -> Result<(), String> {
+pub async fn check_against_cpu(ctx: &GpuContext) -> Result<(), KernelMismatch> {
     use crate::rng::Rng;
     let mut rng = Rng::new(5);
     let (n, k) = (5000usize, 4usize);
@@ -253,9 +283,9 @@ pub async fn check_against_cpu(ctx: &GpuContext) -> Result<(), String> {
         })
         .collect();
     let field = crate::raster::MeshField::new(rest.clone(), faces, k, 0.0);
-    let gpu = GpuField::upload(ctx, &field).map_err(|e| e.to_string())?;
+    let gpu = GpuField::upload(ctx, &field)?;
     let kernels = MotionKernels::new(ctx);
-    let moved = MovedMesh::new(ctx, &kernels, &gpu, &rest, &parts).map_err(|e| e.to_string())?;
+    let moved = MovedMesh::new(ctx, &kernels, &gpu, &rest, &parts)?;
     let g4: Vec<[f32; 4]> = grads.iter().map(|g| g.extend(0.0).into()).collect();
     ctx.queue
         .write_buffer(&gpu.grad_positions, 0, bytemuck::cast_slice(&g4));
@@ -263,11 +293,8 @@ pub async fn check_against_cpu(ctx: &GpuContext) -> Result<(), String> {
     moved.encode_apply(ctx, &kernels, &mut encoder, &motions);
     moved.encode_reduce(ctx, &kernels, &mut encoder);
     ctx.queue.submit([encoder.finish()]);
-    let got: Vec<[f32; 4]> = ctx
-        .read_buffer(&gpu.positions, n)
-        .await
-        .map_err(|e| e.to_string())?;
-    let sums = moved.read_sums(ctx).await.map_err(|e| e.to_string())?;
+    let got: Vec<[f32; 4]> = ctx.read_buffer(&gpu.positions, n).await?;
+    let sums = moved.read_sums(ctx).await?;
     let mut want = vec![PartSums::default(); k];
     for i in 0..n {
         let (a, b) = motions[parts[i] as usize];
@@ -275,7 +302,11 @@ pub async fn check_against_cpu(ctx: &GpuContext) -> Result<(), String> {
         let y = a * x + b;
         let g = Vec3::from_slice(&got[i][..3]).as_dvec3();
         if (g - y).length() > 1e-5 {
-            return Err(format!("vertex {i} moved to {g}, expected {y}"));
+            return Err(KernelMismatch::Position {
+                vertex: i,
+                got: g,
+                want: y,
+            });
         }
         want[parts[i] as usize].add(grads[i].as_dvec3(), x);
     }
@@ -295,9 +326,12 @@ pub async fn check_against_cpu(ctx: &GpuContext) -> Result<(), String> {
                 .fold(0.0, |a: f64, &b| a.max(b)),
         );
         if err > 1e-4 * scale || s.count != w.count {
-            return Err(format!(
-                "part {p}: GPU sums {s:?} differ from the CPU's {w:?} (max error {err})"
-            ));
+            return Err(KernelMismatch::Sums {
+                part: p,
+                got: *s,
+                want: *w,
+                error: err,
+            });
         }
     }
     Ok(())

@@ -17,6 +17,7 @@
 
 use glam::{DMat3, DVec3, Vec3};
 
+pub use self::error::{MotionLossError, SurfaceError};
 use super::PartSums;
 use crate::mesh::closest::TriangleBvh;
 use crate::raster::MeshField;
@@ -54,13 +55,13 @@ impl StateSurface {
         colors: Vec<Vec3>,
         opacity: Vec<f32>,
         num_parts: usize,
-    ) -> Result<Self, String> {
+    ) -> Result<Self, SurfaceError> {
         let n = positions.len();
         if num_parts == 0 {
-            return Err("num_parts is 0, expected at least 1 (the static base)".into());
+            return Err(SurfaceError::NoParts);
         }
         if u32::try_from(n).is_err() {
-            return Err(format!("{n} vertices do not fit u32 face indices"));
+            return Err(SurfaceError::TooManyVertices(n));
         }
         for (what, len) in [
             ("parts", parts.len()),
@@ -68,41 +69,47 @@ impl StateSurface {
             ("opacity", opacity.len()),
         ] {
             if len != n {
-                return Err(format!(
-                    "{what} has {len} values, expected one per vertex ({n})"
-                ));
+                return Err(SurfaceError::Length {
+                    what,
+                    len,
+                    vertices: n,
+                });
             }
         }
         if let Some(v) = positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!(
-                "vertex {v} has a non-finite position {}",
-                positions[v]
-            ));
+            return Err(SurfaceError::NonFinitePosition {
+                vertex: v,
+                position: positions[v],
+            });
         }
         if let Some(v) = colors.iter().position(|c| !c.is_finite()) {
-            return Err(format!("vertex {v} has a non-finite colour {}", colors[v]));
+            return Err(SurfaceError::NonFiniteColor {
+                vertex: v,
+                color: colors[v],
+            });
         }
         if let Some(v) = opacity.iter().position(|o| !(0.0..=1.0).contains(o)) {
-            return Err(format!(
-                "vertex {v} has opacity {}, expected a value in [0, 1]",
-                opacity[v]
-            ));
+            return Err(SurfaceError::Opacity {
+                vertex: v,
+                opacity: opacity[v],
+            });
         }
         if let Some(v) = parts.iter().position(|&p| p as usize >= num_parts) {
-            return Err(format!(
-                "vertex {v} has part {}, expected 0 to {}",
-                parts[v],
-                num_parts - 1
-            ));
+            return Err(SurfaceError::Part {
+                vertex: v,
+                part: parts[v],
+                num_parts,
+            });
         }
         if let Some(f) = faces
             .iter()
             .position(|f| f.iter().any(|&v| v as usize >= n))
         {
-            return Err(format!(
-                "face {f} is {:?}, but there are only {n} vertices",
-                faces[f]
-            ));
+            return Err(SurfaceError::FaceIndex {
+                face: f,
+                indices: faces[f],
+                vertices: n,
+            });
         }
 
         let mut part_faces = vec![Vec::new(); num_parts];
@@ -137,7 +144,7 @@ impl StateSurface {
 
     /// The state surface of a mesh field: hardened part labels, view-independent (degree-0 SH)
     /// colour and sigmoid opacity.
-    pub fn from_field(field: &MeshField) -> Result<Self, String> {
+    pub fn from_field(field: &MeshField) -> Result<Self, SurfaceError> {
         field.validate()?;
         let parts = crate::mesh::topology::harden_parts(field);
         let colors = (0..field.num_vertices())
@@ -267,24 +274,24 @@ pub fn vertex_motion_loss(
     target: &StateSurface,
     motions: &[(DMat3, DVec3)],
     weights: &VertexMotionWeights,
-) -> Result<VertexMotionLoss, String> {
+) -> Result<VertexMotionLoss, MotionLossError> {
     let num_parts = source.num_parts;
     if target.num_parts != num_parts {
-        return Err(format!(
-            "the source has {num_parts} parts but the target {}",
-            target.num_parts
-        ));
+        return Err(MotionLossError::PartCounts {
+            source_parts: num_parts,
+            target_parts: target.num_parts,
+        });
     }
     if motions.len() < num_parts {
-        return Err(format!(
-            "{} motions for {num_parts} parts (one per part, the static base included)",
-            motions.len()
-        ));
+        return Err(MotionLossError::TooFewMotions {
+            motions: motions.len(),
+            parts: num_parts,
+        });
     }
     if let Some(k) =
         (1..num_parts).find(|&k| !(motions[k].0.is_finite() && motions[k].1.is_finite()))
     {
-        return Err(format!("the motion of part {k} is not finite"));
+        return Err(MotionLossError::NonFiniteMotion(k));
     }
     for (what, value) in [
         ("color", weights.color),
@@ -292,9 +299,7 @@ pub fn vertex_motion_loss(
         ("max_distance", weights.max_distance),
     ] {
         if !(value.is_finite() && value >= 0.0) {
-            return Err(format!(
-                "weight {what} is {value}, expected a finite value ≥ 0"
-            ));
+            return Err(MotionLossError::Weight { what, value });
         }
     }
 
@@ -445,5 +450,6 @@ fn closest_on_part(target: &StateSurface, part: usize, moved: DVec3) -> Option<M
     })
 }
 
+mod error;
 #[cfg(test)]
 mod tests;

@@ -24,7 +24,8 @@ pub fn read_zip(name: &str, bytes: &[u8]) -> Result<FileSet, DataError> {
         if entry.is_dir() || raw.starts_with("__MACOSX/") {
             continue;
         }
-        let path = normalize(&raw).map_err(|e| DataError::field(name, format!("entry {i}"), e))?;
+        let path = normalize(&raw)
+            .map_err(|e| DataError::field(name, format!("entry {i}"), e.to_string()))?;
         let mut contents = Vec::with_capacity(entry.size().min(1 << 30) as usize);
         entry
             .read_to_end(&mut contents)

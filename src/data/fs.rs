@@ -5,14 +5,32 @@ use std::io::Write;
 use std::path::{Component, Path};
 
 use super::FileSet;
-use super::error::DataError;
+use super::error::{DataError, DatasetErrors};
+
+/// Why [`read_dataset`] found no valid dataset.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum ReadDatasetError {
+    /// The folder could not be read.
+    #[error(transparent)]
+    Folder(#[from] DataError),
+    /// The folder was read but is not a valid dataset; lists every problem after the folder's name.
+    #[error("{root}: {} problem(s):\n{errors}", .errors.0.len())]
+    Invalid {
+        /// The folder as given.
+        root: String,
+        /// Every problem found.
+        errors: DatasetErrors,
+    },
+}
 
 /// Reads the dataset folder `root` (see [`read_dir`]) and validates it; every problem found is
 /// listed in the error, after the folder's name.
-pub fn read_dataset(root: &Path) -> Result<super::Dataset, String> {
-    let files = read_dir(root).map_err(|e| e.to_string())?;
-    super::Dataset::from_files(&files)
-        .map_err(|e| format!("{}: {} problem(s):\n{e}", root.display(), e.0.len()))
+pub fn read_dataset(root: &Path) -> Result<super::Dataset, ReadDatasetError> {
+    let files = read_dir(root)?;
+    super::Dataset::from_files(&files).map_err(|errors| ReadDatasetError::Invalid {
+        root: root.display().to_string(),
+        errors,
+    })
 }
 
 /// Folders nested deeper than this are not followed (guards against symlink loops).

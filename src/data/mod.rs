@@ -42,7 +42,7 @@ pub use dataset::{Dataset, GroundTruth, ViewSet};
 pub use error::{DataError, DatasetErrors};
 pub use frame::Frame;
 #[cfg(not(target_arch = "wasm32"))]
-pub use fs::{read_dataset, read_dir, write_dir};
+pub use fs::{ReadDatasetError, read_dataset, read_dir, write_dir};
 pub use gt::{GtJoint, GtMeshes, JointKind};
 pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png};
 pub use npy::encode_npy;

@@ -305,8 +305,19 @@ fn check_data_size(
     }
 }
 
-/// Reads one element as a whole number; `Err` holds the offending value as text.
-fn element(dtype: NpyDtype, big_endian: bool, raw: &[u8]) -> Result<i64, String> {
+/// An element that is no whole number within `i64`; it displays as the offending value.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+enum BadElement {
+    /// An unsigned value above `i64::MAX`.
+    #[error("{0}")]
+    TooLarge(u64),
+    /// A float that is not a finite whole number below 1e15.
+    #[error("{0} (not a whole number)")]
+    NotWhole(f64),
+}
+
+/// Reads one element as a whole number; `Err` holds the offending value.
+fn element(dtype: NpyDtype, big_endian: bool, raw: &[u8]) -> Result<i64, BadElement> {
     let mut b = [0u8; 8];
     let n = raw.len().min(8);
     b[..n].copy_from_slice(&raw[..n]);
@@ -323,7 +334,7 @@ fn element(dtype: NpyDtype, big_endian: bool, raw: &[u8]) -> Result<i64, String>
         NpyDtype::UInt(4) => i64::from(u32::from_le_bytes([b[0], b[1], b[2], b[3]])),
         NpyDtype::UInt(_) => {
             let v = u64::from_le_bytes(b);
-            i64::try_from(v).map_err(|_| v.to_string())?
+            i64::try_from(v).map_err(|_| BadElement::TooLarge(v))?
         }
         NpyDtype::Float(n) => {
             let x = if n == 4 {
@@ -332,7 +343,7 @@ fn element(dtype: NpyDtype, big_endian: bool, raw: &[u8]) -> Result<i64, String>
                 f64::from_le_bytes(b)
             };
             if !(x.is_finite() && x.fract() == 0.0 && x.abs() < 1e15) {
-                return Err(format!("{x} (not a whole number)"));
+                return Err(BadElement::NotWhole(x));
             }
             x as i64
         }
@@ -363,7 +374,7 @@ pub(crate) fn decode_parts_npy(file: &str, bytes: &[u8]) -> Result<PartMap, Data
                     ),
                 )
             };
-            let v = element(h.dtype, h.big_endian, raw).map_err(bad)?;
+            let v = element(h.dtype, h.big_endian, raw).map_err(|e| bad(e.to_string()))?;
             let id = i16::try_from(v)
                 .ok()
                 .filter(|&id| id >= -1)

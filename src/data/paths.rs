@@ -2,15 +2,27 @@
 
 use super::FileSet;
 
+/// Why a `file_path` cannot name a file inside the dataset; each variant holds the path as written.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub(crate) enum PathError {
+    /// An absolute path (`/x`, `C:/x`).
+    #[error("expected a path relative to the dataset folder, found the absolute path \"{0}\"")]
+    Absolute(String),
+    /// A path whose `..` climbs above the dataset root.
+    #[error("\"{0}\" points outside the dataset folder")]
+    Outside(String),
+    /// A path with no component left (`./`).
+    #[error("expected a path to an image, found \"{0}\"")]
+    Empty(String),
+}
+
 /// Cleans a `file_path` from a transforms file into a dataset-relative path with `'/'` separators:
-/// drops `./` and empty components, accepts `\` separators, resolves `a/../b`. Errors (as a message) on
+/// drops `./` and empty components, accepts `\` separators, resolves `a/../b`. Errors on
 /// absolute paths and on paths that leave the dataset root.
-pub(crate) fn normalize(raw: &str) -> Result<String, String> {
+pub(crate) fn normalize(raw: &str) -> Result<String, PathError> {
     let unified = raw.replace('\\', "/");
     if unified.starts_with('/') || unified.as_bytes().get(1) == Some(&b':') {
-        return Err(format!(
-            "expected a path relative to the dataset folder, found the absolute path \"{raw}\""
-        ));
+        return Err(PathError::Absolute(raw.to_string()));
     }
     let mut parts: Vec<&str> = Vec::new();
     for part in unified.split('/') {
@@ -18,14 +30,14 @@ pub(crate) fn normalize(raw: &str) -> Result<String, String> {
             "" | "." => {}
             ".." => {
                 if parts.pop().is_none() {
-                    return Err(format!("\"{raw}\" points outside the dataset folder"));
+                    return Err(PathError::Outside(raw.to_string()));
                 }
             }
             p => parts.push(p),
         }
     }
     if parts.is_empty() {
-        return Err(format!("expected a path to an image, found \"{raw}\""));
+        return Err(PathError::Empty(raw.to_string()));
     }
     Ok(parts.join("/"))
 }
@@ -127,9 +139,19 @@ mod tests {
             "start/train/rgba/0000"
         );
         assert_eq!(normalize("a\\b/../c.png").unwrap(), "a/c.png");
-        assert!(normalize("../x").unwrap_err().contains("outside"));
+        assert!(
+            normalize("../x")
+                .unwrap_err()
+                .to_string()
+                .contains("outside")
+        );
         assert!(normalize("a/../../x").is_err());
-        assert!(normalize("/etc/passwd").unwrap_err().contains("absolute"));
+        assert!(
+            normalize("/etc/passwd")
+                .unwrap_err()
+                .to_string()
+                .contains("absolute")
+        );
         assert!(normalize("C:/x.png").is_err());
         assert!(normalize("./").is_err());
     }

@@ -208,7 +208,9 @@ fn parse_frame(
             "the image path, e.g. \"./start/train/rgba/0000\"",
         ))
         .and_then(|v| errs.keep(j.string(&path_field, v)))
-        .and_then(|raw| errs.keep(paths::normalize(raw).map_err(|m| j.err(&path_field, m))));
+        .and_then(|raw| {
+            errs.keep(paths::normalize(raw).map_err(|m| j.err(&path_field, m.to_string())))
+        });
     let m_field = json::join(&field, "transform_matrix");
     let matrix = errs
         .keep(j.required(

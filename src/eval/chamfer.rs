@@ -60,14 +60,28 @@ fn directed(from: &[Vec3], to: &KdTree) -> (f64, f64) {
     (sum / n, sum_sq / n)
 }
 
+/// Why two point sets have no Chamfer distance; `&'static str` names the set (`first` or `second`).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum PointSetFault {
+    /// A set without points.
+    #[error("the {0} point set is empty")]
+    Empty(&'static str),
+    /// A set with a NaN or infinite point.
+    #[error("the {0} point set has a non-finite point")]
+    NonFinite(&'static str),
+    /// The distance overflows.
+    #[error("the points are too far apart for a finite distance")]
+    TooFar,
+}
+
 /// Chamfer distance between two point sets (both conventions). Errors for an empty or non-finite set.
-pub fn chamfer_points(a: &[Vec3], b: &[Vec3]) -> Result<ChamferDistance, String> {
+pub fn chamfer_points(a: &[Vec3], b: &[Vec3]) -> Result<ChamferDistance, PointSetFault> {
     for (name, set) in [("first", a), ("second", b)] {
         if set.is_empty() {
-            return Err(format!("the {name} point set is empty"));
+            return Err(PointSetFault::Empty(name));
         }
         if set.iter().any(|p| !p.is_finite()) {
-            return Err(format!("the {name} point set has a non-finite point"));
+            return Err(PointSetFault::NonFinite(name));
         }
     }
     let (mean_ab, mean_sq_ab) = directed(a, &KdTree::new(b));
@@ -79,7 +93,7 @@ pub fn chamfer_points(a: &[Vec3], b: &[Vec3]) -> Result<ChamferDistance, String>
     if cd.cd_peer.is_finite() && cd.cd_mm.is_finite() {
         Ok(cd)
     } else {
-        Err("the points are too far apart for a finite distance".into())
+        Err(PointSetFault::TooFar)
     }
 }
 
@@ -105,5 +119,5 @@ pub fn chamfer_meshes(
         .map_err(|e| MeshFault::First(e.to_string()))?;
     let pb = sample_surface(b, options.samples, options.seed)
         .map_err(|e| MeshFault::Second(e.to_string()))?;
-    chamfer_points(&pa, &pb).map_err(MeshFault::Distance)
+    chamfer_points(&pa, &pb).map_err(|e| MeshFault::Distance(e.to_string()))
 }

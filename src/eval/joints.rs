@@ -28,22 +28,38 @@ fn unit(v: glam::Vec3) -> DVec3 {
     dvec(v).normalize_or_zero()
 }
 
+/// Why a joint cannot be evaluated.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum JointFault {
+    /// The axis origin has a NaN or infinite coordinate.
+    #[error("axis origin {0} is not finite")]
+    Origin(glam::Vec3),
+    /// The axis direction is (nearly) zero or not finite.
+    #[error("axis direction {0} is zero or not finite")]
+    Direction(glam::Vec3),
+    /// A joint value is NaN or infinite.
+    #[error("joint values start {start} / end {end} are not finite")]
+    Values {
+        /// Value in the start state.
+        start: f32,
+        /// Value in the end state.
+        end: f32,
+    },
+}
+
 /// Checks that a joint can be evaluated: finite values and a non-zero direction.
-pub fn validate_joint(joint: &GtJoint) -> Result<(), String> {
+pub fn validate_joint(joint: &GtJoint) -> Result<(), JointFault> {
     if !joint.origin.is_finite() {
-        return Err(format!("axis origin {} is not finite", joint.origin));
+        return Err(JointFault::Origin(joint.origin));
     }
     if !joint.direction.is_finite() || dvec(joint.direction).length() <= 1e-12 {
-        return Err(format!(
-            "axis direction {} is zero or not finite",
-            joint.direction
-        ));
+        return Err(JointFault::Direction(joint.direction));
     }
     if !joint.start.is_finite() || !joint.end.is_finite() {
-        return Err(format!(
-            "joint values start {} / end {} are not finite",
-            joint.start, joint.end
-        ));
+        return Err(JointFault::Values {
+            start: joint.start,
+            end: joint.end,
+        });
     }
     Ok(())
 }
@@ -229,7 +245,7 @@ pub fn match_joints_using(
             validate_joint(j).map_err(|reason| EvalError::InvalidJoint {
                 side,
                 index,
-                reason,
+                reason: reason.to_string(),
             })?;
         }
     }

@@ -27,11 +27,11 @@ pub mod tables;
 
 pub use crate::synth::PartBucket;
 pub use chamfer::{
-    ChamferDistance, ChamferOptions, chamfer_meshes, chamfer_points, sample_surface,
+    ChamferDistance, ChamferOptions, PointSetFault, chamfer_meshes, chamfer_points, sample_surface,
 };
 pub use joints::{
-    JointMatching, JointPairMetrics, Solver, axis_angle_deg, axis_line_distance, axis_pos,
-    match_joints, match_joints_using, motion_error,
+    JointFault, JointMatching, JointPairMetrics, Solver, axis_angle_deg, axis_line_distance,
+    axis_pos, match_joints, match_joints_using, motion_error,
 };
 pub use mesh_quality::{PartQuality, ReconstructionReport, StateQuality, reconstruction_report};
 pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_fit, evaluate_object};

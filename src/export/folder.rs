@@ -4,10 +4,11 @@
 use serde::Serialize;
 
 use super::joints::{JointRecord, joint_records};
+use super::twin::NoStartState;
 use super::{JOINTS_FILE, Twin, export_twin};
-use crate::data::{Dataset, FileSet};
+use crate::data::{DataError, Dataset, FileSet};
 use crate::eval::{
-    ChamferOptions, EvalOptions, ObjectMetrics, evaluate_fit, reconstruction_report,
+    ChamferOptions, EvalError, EvalOptions, ObjectMetrics, evaluate_fit, reconstruction_report,
 };
 use crate::fit::object::{FitConfig, ObjectFit};
 
@@ -30,8 +31,45 @@ pub struct FitFolder {
     pub twin: Twin,
 }
 
-fn json(value: &impl Serialize, what: &str) -> Result<String, String> {
-    serde_json::to_string_pretty(value).map_err(|e| format!("{what}: cannot serialise: {e}"))
+/// Which step of [`FitFolder::build`] failed, for which object (`id`) or file (`what`).
+#[derive(Debug, thiserror::Error)]
+pub enum FolderError {
+    /// The fit could not be scored against the dataset's ground truth.
+    #[error("{id}: scoring against the ground truth: {source}")]
+    Score {
+        /// The fit's id.
+        id: String,
+        /// Why.
+        source: EvalError,
+    },
+    /// A file's JSON could not be written.
+    #[error("{what}: cannot serialise: {source}")]
+    Serialise {
+        /// The file.
+        what: &'static str,
+        /// Why.
+        source: serde_json::Error,
+    },
+    /// The fit has no twin.
+    #[error("{id}: {source}")]
+    Twin {
+        /// The fit's id.
+        id: String,
+        /// Why.
+        source: NoStartState,
+    },
+    /// The twin's URDF, GLB or archive could not be written.
+    #[error("{id}: exporting: {source}")]
+    Export {
+        /// The fit's id.
+        id: String,
+        /// Why.
+        source: DataError,
+    },
+}
+
+fn json(value: &impl Serialize, what: &'static str) -> Result<String, FolderError> {
+    serde_json::to_string_pretty(value).map_err(|source| FolderError::Serialise { what, source })
 }
 
 impl FitFolder {
@@ -44,7 +82,7 @@ impl FitFolder {
         id: &str,
         category: &str,
         seconds: f64,
-    ) -> Result<FitFolder, String> {
+    ) -> Result<FitFolder, FolderError> {
         let quality = reconstruction_report(
             &fit.reconstruction,
             &dataset.gt_meshes,
@@ -52,7 +90,10 @@ impl FitFolder {
         );
         let metrics = evaluate_fit(fit, dataset, id, category, &EvalOptions::default())
             .transpose()
-            .map_err(|e| format!("{id}: scoring against the ground truth: {e}"))?;
+            .map_err(|source| FolderError::Score {
+                id: id.to_string(),
+                source,
+            })?;
         let joints = joint_records(fit);
         let report = serde_json::json!({
             "id": id,
@@ -69,9 +110,15 @@ impl FitFolder {
             "metrics": metrics,
         });
         let joints_json = json(&joints, JOINTS_FILE)?.into_bytes();
-        let twin = Twin::from_fit(fit, id).map_err(|e| format!("{id}: {e}"))?;
+        let twin = Twin::from_fit(fit, id).map_err(|source| FolderError::Twin {
+            id: id.to_string(),
+            source,
+        })?;
         let exports = export_twin(&twin.object(), &twin.end_configuration(), &joints_json)
-            .map_err(|e| format!("{id}: exporting: {e}"))?;
+            .map_err(|source| FolderError::Export {
+                id: id.to_string(),
+                source,
+            })?;
         let mut files = fit.as_ground_truth().to_files();
         files.insert(JOINTS_FILE.into(), joints_json);
         files.insert(REPORT_FILE.into(), json(&report, REPORT_FILE)?.into_bytes());

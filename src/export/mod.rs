@@ -22,10 +22,10 @@ pub mod twin;
 pub mod urdf;
 
 pub use archive::write_zip;
-pub use folder::{FitFolder, REPORT_FILE};
+pub use folder::{FitFolder, FolderError, REPORT_FILE};
 pub use glb::write_glb;
 pub use joints::{GeometryRecord, JointRecord, joint_records};
-pub use twin::{Twin, TwinPart};
+pub use twin::{NoStartState, Twin, TwinPart};
 pub use urdf::write_urdf;
 
 use crate::data::{DataError, FileSet};

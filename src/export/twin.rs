@@ -42,6 +42,11 @@ pub struct TwinPart {
     pub colors: Option<Vec<[f32; 3]>>,
 }
 
+/// Why [`Twin::from_fit`] has no meshes to take: the fit lacks its start-state reconstruction.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("the fit has no start-state reconstruction")]
+pub struct NoStartState;
+
 /// An articulated twin: parts (base first) and one joint per movable part.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Twin {
@@ -55,13 +60,13 @@ pub struct Twin {
 impl Twin {
     /// The twin of a fit: the start state's part meshes with their fitted colours (the SH DC term,
     /// decoded from the images' sRGB), and the fitted joints.
-    pub fn from_fit(fit: &ObjectFit, name: &str) -> Result<Twin, String> {
+    pub fn from_fit(fit: &ObjectFit, name: &str) -> Result<Twin, NoStartState> {
         let state = fit
             .reconstruction
             .states
             .iter()
             .find(|s| s.state == State::Start)
-            .ok_or("the fit has no start-state reconstruction")?;
+            .ok_or(NoStartState)?;
         let field = &state.field;
         let subs = crate::mesh::part_submeshes(&field.faces, &state.parts, field.num_parts);
         let parts = subs

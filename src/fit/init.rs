@@ -145,22 +145,26 @@ fn thin(samples: &[Sample], cell: f32) -> Vec<Sample> {
         .collect()
 }
 
+/// Why [`initial_field`] has nothing to start from: no frame has a usable depth map.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error(
+    "no frame has foreground pixels with valid depth: the reconstruction starts from the depth maps"
+)]
+pub struct NoDepthSamples;
+
 /// The initial mesh field of one state (see the module docs). Errors when no frame has a usable
 /// depth map.
 pub fn initial_field(
     frames: &[Frame],
     num_parts: usize,
     options: &InitOptions,
-) -> Result<MeshField, String> {
+) -> Result<MeshField, NoDepthSamples> {
     let mut samples = Vec::new();
     for frame in frames {
         frame_samples(frame, num_parts, &mut samples);
     }
     if samples.is_empty() {
-        return Err(
-            "no frame has foreground pixels with valid depth: the reconstruction starts from the depth maps"
-                .into(),
-        );
+        return Err(NoDepthSamples);
     }
     // Pixel footprint at the median depth of the first view sets the voxel size.
     let first = frames.iter().find(|f| f.depth.is_some()).map(|f| f.camera);
@@ -244,7 +248,9 @@ mod tests {
         for f in &mut dataset.views[0].frames {
             f.depth = None;
         }
-        let err = initial_field(&dataset.views[0].frames, 2, &InitOptions::default()).unwrap_err();
+        let err = initial_field(&dataset.views[0].frames, 2, &InitOptions::default())
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("depth"), "{err}");
     }
 }

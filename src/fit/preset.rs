@@ -6,6 +6,11 @@
 
 use serde::Serialize;
 
+/// A preset name [`Preset::parse`] does not know; the message lists the valid ones.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown preset '{0}', expected one of tiny, fast, paper")]
+pub struct UnknownPreset(pub String);
+
 /// Named budgets: `tiny` for tests, `fast` for the CPU demo, `paper` for the paper's setting.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -28,11 +33,11 @@ impl Preset {
     }
 
     /// Parses a preset name; the error lists the valid ones.
-    pub fn parse(name: &str) -> Result<Preset, String> {
+    pub fn parse(name: &str) -> Result<Preset, UnknownPreset> {
         Preset::ALL
             .into_iter()
             .find(|p| p.name().eq_ignore_ascii_case(name))
-            .ok_or_else(|| format!("unknown preset '{name}', expected one of tiny, fast, paper"))
+            .ok_or_else(|| UnknownPreset(name.to_string()))
     }
 
     /// What this preset spends (see [`Budget`]).
@@ -127,6 +132,7 @@ mod tests {
         assert!(
             Preset::parse("huge")
                 .unwrap_err()
+                .to_string()
                 .contains("tiny, fast, paper")
         );
         let it = |p: Preset| p.budget().reconstruction_iterations;

@@ -108,7 +108,7 @@ pub async fn fit_and_export(
         &input.category,
         seconds,
     )
-    .map_err(PipelineError::Export)?;
+    .map_err(|e| PipelineError::Export(e.to_string()))?;
     Ok(FitRun {
         fit,
         folder,

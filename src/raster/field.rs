@@ -14,6 +14,46 @@ pub const SH_FLOATS: usize = SH_COEFFS * 3;
 /// SH degree-0 basis constant: a DC coefficient c gives colour `C0 · c + 0.5`.
 pub const SH_C0: f32 = 0.282_094_8;
 
+/// Why a [`MeshField`] is inconsistent ([`MeshField::validate`]).
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum FieldError {
+    /// A part count outside 1..=`MAX_PARTS`.
+    #[error(
+        "num_parts is {num_parts}, expected 1 to {max} (static base + up to {} movable parts)",
+        MAX_PARTS - 1,
+        max = MAX_PARTS
+    )]
+    PartCount {
+        /// The field's part count.
+        num_parts: usize,
+    },
+    /// A per-vertex array whose length does not match the vertex count.
+    #[error("{what} has {len} values, expected {want} for {vertices} vertices")]
+    Length {
+        /// The array's name.
+        what: &'static str,
+        /// Its length.
+        len: usize,
+        /// The length the vertex count implies.
+        want: usize,
+        /// The vertex count.
+        vertices: usize,
+    },
+    /// A face with a vertex index out of range.
+    #[error("face {face} references vertex {indices:?}, but there are only {vertices} vertices")]
+    FaceIndex {
+        /// Index of the face.
+        face: usize,
+        /// Its vertex indices.
+        indices: [u32; 3],
+        /// The vertex count.
+        vertices: usize,
+    },
+    /// A vertex position with a NaN or infinite coordinate.
+    #[error("vertex {0} has a non-finite position")]
+    NonFinite(usize),
+}
+
 /// A triangle mesh whose vertices carry appearance, opacity and part logits.
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshField {
@@ -68,14 +108,12 @@ impl MeshField {
     }
 
     /// Checks that every array has the length the vertex count implies and every index is valid.
-    pub fn validate(&self) -> Result<(), String> {
+    pub fn validate(&self) -> Result<(), FieldError> {
         let n = self.num_vertices();
         if !(1..=MAX_PARTS).contains(&self.num_parts) {
-            return Err(format!(
-                "num_parts is {}, expected 1 to {MAX_PARTS} (static base + up to {} movable parts)",
-                self.num_parts,
-                MAX_PARTS - 1
-            ));
+            return Err(FieldError::PartCount {
+                num_parts: self.num_parts,
+            });
         }
         for (what, len, want) in [
             ("sh", self.sh.len(), n * SH_FLOATS),
@@ -83,9 +121,12 @@ impl MeshField {
             ("part_logits", self.part_logits.len(), n * self.num_parts),
         ] {
             if len != want {
-                return Err(format!(
-                    "{what} has {len} values, expected {want} for {n} vertices"
-                ));
+                return Err(FieldError::Length {
+                    what,
+                    len,
+                    want,
+                    vertices: n,
+                });
             }
         }
         if let Some((f, face)) = self
@@ -94,12 +135,14 @@ impl MeshField {
             .enumerate()
             .find(|(_, face)| face.iter().any(|&i| i as usize >= n))
         {
-            return Err(format!(
-                "face {f} references vertex {face:?}, but there are only {n} vertices"
-            ));
+            return Err(FieldError::FaceIndex {
+                face: f,
+                indices: *face,
+                vertices: n,
+            });
         }
         if let Some(v) = self.positions.iter().position(|p| !p.is_finite()) {
-            return Err(format!("vertex {v} has a non-finite position"));
+            return Err(FieldError::NonFinite(v));
         }
         Ok(())
     }
@@ -260,10 +303,10 @@ mod tests {
     #[test]
     fn validation_names_the_problem() {
         let mut f = MeshField::new(vec![Vec3::ZERO; 3], vec![[0, 1, 3]], 2, 0.0);
-        assert!(f.validate().unwrap_err().contains("face 0"));
+        assert!(f.validate().unwrap_err().to_string().contains("face 0"));
         f.faces = vec![[0, 1, 2]];
         assert!(f.validate().is_ok());
         f.opacity.pop();
-        assert!(f.validate().unwrap_err().contains("opacity"));
+        assert!(f.validate().unwrap_err().to_string().contains("opacity"));
     }
 }

@@ -14,7 +14,9 @@ pub mod reference;
 mod settings;
 mod state;
 
-pub use field::{FieldGradients, GpuField, MeshField, SH_C0, SH_FLOATS, vertex_corners};
+pub use field::{
+    FieldError, FieldGradients, GpuField, MeshField, SH_C0, SH_FLOATS, vertex_corners,
+};
 pub use kernels::{MAX_PARTS, TILE};
 pub use rasterizer::{ForwardStats, Rasterizer};
 pub use settings::{BASE_CHANNELS, RasterSettings, sort_key_bits};

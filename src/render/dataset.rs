@@ -138,6 +138,17 @@ pub enum DatasetRenderError {
     Data(#[from] DataError),
 }
 
+/// Everything that can stop [`capture_dataset`]: the render, or reading its files back.
+#[derive(Debug, thiserror::Error)]
+pub enum CaptureError {
+    /// Rendering failed.
+    #[error(transparent)]
+    Render(#[from] DatasetRenderError),
+    /// The rendered files do not read back as a valid dataset.
+    #[error(transparent)]
+    ReadBack(#[from] crate::data::DatasetErrors),
+}
+
 /// Ground truth of a two-state capture.
 #[derive(Debug, Clone, PartialEq)]
 pub struct CaptureTruth {
@@ -279,7 +290,7 @@ pub async fn capture_dataset(
     obj: &ArticulatedObject,
     spec: &RenderSpec,
     progress: &mut dyn FnMut(RenderProgress),
-) -> Result<crate::data::Dataset, String> {
+) -> Result<crate::data::Dataset, CaptureError> {
     let mut files = FileSet::new();
     render_dataset(
         ctx,
@@ -291,9 +302,8 @@ pub async fn capture_dataset(
         },
         progress,
     )
-    .await
-    .map_err(|e| e.to_string())?;
-    crate::data::Dataset::from_files(&files).map_err(|e| e.to_string())
+    .await?;
+    Ok(crate::data::Dataset::from_files(&files)?)
 }
 
 /// Renders the two-state dataset of `obj` (see the module docs). Every batch of files — one frame's images,

@@ -26,8 +26,8 @@ mod view;
 pub mod viewer;
 
 pub use dataset::{
-    CaptureTruth, DatasetRenderError, MIN_OBJECT_SIZE, ObjectProblem, RenderProgress, RenderSpec,
-    RenderedDataset, capture_dataset, capture_truth, render_dataset,
+    CaptureError, CaptureTruth, DatasetRenderError, MIN_OBJECT_SIZE, ObjectProblem, RenderProgress,
+    RenderSpec, RenderedDataset, capture_dataset, capture_truth, render_dataset,
 };
 pub use pipeline::GtRenderer;
 pub use sheet::{SheetEntry, contact_sheet, overview_camera};

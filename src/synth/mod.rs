@@ -111,7 +111,7 @@ impl Category {
 
     /// Parses a category: the paper's name in any case, with or without `_`/`-`/spaces
     /// (`storage_furniture`), or a short alias (`storage`, `fridge`, `chair`, `bin`, `glasses`).
-    pub fn parse(text: &str) -> Result<Category, String> {
+    pub fn parse(text: &str) -> Result<Category, UnknownCategory> {
         let key: String = text
             .chars()
             .filter(|c| !matches!(c, '_' | '-' | ' '))
@@ -128,13 +128,7 @@ impl Category {
         };
         alias
             .or_else(|| Category::ALL.into_iter().find(|c| c.slug() == key))
-            .ok_or_else(|| {
-                let names: Vec<&str> = Category::ALL.iter().map(|c| c.name()).collect();
-                format!(
-                    "unknown category '{text}': expected one of {}",
-                    names.join(", ")
-                )
-            })
+            .ok_or_else(|| UnknownCategory(text.to_string()))
     }
 
     /// Movable-part counts this category can be generated with.
@@ -166,6 +160,42 @@ impl std::fmt::Display for Category {
     }
 }
 
+/// A category name [`Category::parse`] does not know; the message lists the valid ones.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown category '{0}': expected one of {names}", names = category_names())]
+pub struct UnknownCategory(pub String);
+
+/// The paper's category names, comma-separated.
+fn category_names() -> String {
+    let names: Vec<&str> = Category::ALL.iter().map(|c| c.name()).collect();
+    names.join(", ")
+}
+
+/// Why [`generate`] made no object.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum GenerateError {
+    /// The category cannot have the asked number of movable parts.
+    #[error("{category} objects have {}..={} movable parts, not {asked}", .range.start(), .range.end())]
+    PartCount {
+        /// The category.
+        category: Category,
+        /// The counts it supports ([`Category::movable_parts`]).
+        range: RangeInclusive<usize>,
+        /// The count asked for.
+        asked: usize,
+    },
+    /// A generator broke its own contract (a bug, not an input problem).
+    #[error("internal error: {category} generator made {got} movable parts instead of {parts}")]
+    WrongPartCount {
+        /// The category.
+        category: Category,
+        /// Movable parts made.
+        got: usize,
+        /// Movable parts asked for.
+        parts: usize,
+    },
+}
+
 /// What to generate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct SynthParams {
@@ -179,17 +209,16 @@ pub struct SynthParams {
 
 /// Generates the object described by `params`. Errors when the category cannot have that many movable parts.
 /// The object's name is `<category>_<parts>p_s<seed>`.
-pub fn generate(params: &SynthParams) -> Result<ArticulatedObject, String> {
+pub fn generate(params: &SynthParams) -> Result<ArticulatedObject, GenerateError> {
     let range = params.category.movable_parts();
     let parts = match params.movable_parts {
         Some(n) if range.contains(&n) => n,
         Some(n) => {
-            return Err(format!(
-                "{} objects have {}..={} movable parts, not {n}",
-                params.category,
-                range.start(),
-                range.end()
-            ));
+            return Err(GenerateError::PartCount {
+                category: params.category,
+                range,
+                asked: n,
+            });
         }
         None => Rng::new(params.seed).int_in(*range.start(), *range.end()),
     };
@@ -203,10 +232,11 @@ pub fn generate(params: &SynthParams) -> Result<ArticulatedObject, String> {
     object.name = format!("{}_{parts}p_s{}", params.category.slug(), params.seed);
     let got = object.parts().movable_count();
     if got != parts {
-        return Err(format!(
-            "internal error: {} generator made {got} movable parts instead of {parts}",
-            params.category
-        ));
+        return Err(GenerateError::WrongPartCount {
+            category: params.category,
+            got,
+            parts,
+        });
     }
     Ok(object)
 }
@@ -226,7 +256,7 @@ mod tests {
             Category::parse("Storage_Furniture"),
             Ok(Category::StorageFurniture)
         );
-        let err = Category::parse("sofa").unwrap_err();
+        let err = Category::parse("sofa").unwrap_err().to_string();
         assert!(err.contains("sofa") && err.contains("TrashCan"), "{err}");
     }
 }

@@ -150,8 +150,8 @@ impl WebDataset {
         seed: u32,
         on_progress: Function,
     ) -> Result<WebDataset, JsError> {
-        let category = Category::parse(&category).map_err(|e| JsError::new(&e))?;
-        let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
+        let category = Category::parse(&category).map_err(js_error)?;
+        let config = FitConfig::preset(Preset::parse(&preset).map_err(js_error)?);
         let object =
             pipeline::demo::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
         let ctx = context().await?;
@@ -291,7 +291,7 @@ pub async fn fit(
     on_event: Function,
     control: Function,
 ) -> Result<FitResult, JsError> {
-    let config = FitConfig::preset(Preset::parse(&preset).map_err(|e| JsError::new(&e))?);
+    let config = FitConfig::preset(Preset::parse(&preset).map_err(js_error)?);
     let ctx = context().await?;
     let mut observer = PageObserver {
         config,

@@ -113,18 +113,24 @@ impl BudgetArgs {
             max_faces: self.max_faces,
             articulation_iterations: self.articulation_iterations,
         };
-        Ok(FitConfig::budgeted(Preset::parse(preset)?, &overrides))
+        Ok(FitConfig::budgeted(
+            Preset::parse(preset).map_err(|e| e.to_string())?,
+            &overrides,
+        ))
     }
 }
 
 /// Both phases' settings of the named preset.
 pub fn fit_config(preset: &str) -> Result<FitConfig, String> {
-    Ok(FitConfig::preset(Preset::parse(preset)?))
+    Ok(FitConfig::preset(
+        Preset::parse(preset).map_err(|e| e.to_string())?,
+    ))
 }
 
 /// The named preset with the named remeshing mode (`part-aware` or `global`).
 pub fn reconstruction_config(preset: &str, remesh: &str) -> Result<ReconstructionConfig, String> {
-    let mut config = ReconstructionConfig::preset(Preset::parse(preset)?);
+    let mut config =
+        ReconstructionConfig::preset(Preset::parse(preset).map_err(|e| e.to_string())?);
     if remesh == "global" {
         config.remesh = RemeshMode::Global;
     }

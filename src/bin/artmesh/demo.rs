@@ -51,7 +51,7 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
             .expect("some folder name is free"),
     };
     let (parts, seed) = (args.parts, args.seed);
-    let category = Category::parse(&args.category)?;
+    let category = Category::parse(&args.category).map_err(|e| e.to_string())?;
     let object =
         demo::demo_object(category, usize::from(parts), seed).map_err(|e| e.to_string())?;
     let config = args.budget.fit_config(&args.preset)?;

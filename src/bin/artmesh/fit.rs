@@ -47,9 +47,9 @@ pub fn run(args: FitArgs) -> Result<ExitCode, String> {
     if args.remesh == "global" {
         config.reconstruction.remesh = RemeshMode::Global;
     }
-    config.articulation.ablation = Ablation::parse(&args.ablation)?;
+    config.articulation.ablation = Ablation::parse(&args.ablation).map_err(|e| e.to_string())?;
     if let Some(g) = args.geometry {
-        config.articulation.geometry = GeometryUse::parse(&g)?;
+        config.articulation.geometry = GeometryUse::parse(&g).map_err(|e| e.to_string())?;
     }
     capture::fresh_folder(&args.out)?;
     let input = pipeline::read_dataset(&args.dataset).map_err(|e| e.to_string())?;

@@ -59,7 +59,7 @@ pub fn run(args: &LearnArgs) -> Result<ExitCode, String> {
         ));
     }
     let spec = SceneSpec {
-        category: artmesh::synth::Category::parse(category)?,
+        category: artmesh::synth::Category::parse(category).map_err(|e| e.to_string())?,
         movable_parts: Some(*parts),
         seed: *seed,
         size,
@@ -74,7 +74,7 @@ pub fn run(args: &LearnArgs) -> Result<ExitCode, String> {
     };
     let ctx = context()?;
     let start = std::time::Instant::now();
-    let problem = pollster::block_on(synthetic_scene(&ctx, &spec))?;
+    let problem = pollster::block_on(synthetic_scene(&ctx, &spec)).map_err(|e| e.to_string())?;
     eprintln!(
         "learn: {category} at {size}x{size}, {views} views; starting mesh {} vertices, {} faces",
         problem.field.num_vertices(),

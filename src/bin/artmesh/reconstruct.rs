@@ -58,7 +58,7 @@ fn reconstruct(
     out: &Path,
     config: &ReconstructionConfig,
 ) -> Result<eval::ReconstructionReport, String> {
-    let dataset = data::read_dataset(root)?;
+    let dataset = data::read_dataset(root).map_err(|e| e.to_string())?;
     let ctx = context()?;
     let mut bar = progress::Bar::new("reconstruct");
     let reconstruction = pollster::block_on(artmesh::fit::reconstruct::reconstruct(

@@ -51,13 +51,13 @@ pub struct RenderArgs {
 
 /// `artmesh synth`: the generated object under OUT/object/ and, unless `--object-only`, its dataset.
 pub fn synth(args: SynthArgs) -> Result<ExitCode, String> {
-    let category = Category::parse(&args.category)?;
+    let category = Category::parse(&args.category).map_err(|e| e.to_string())?;
     let params = SynthParams {
         category,
         movable_parts: args.parts,
         seed: args.seed,
     };
-    let object = generate(&params)?;
+    let object = generate(&params).map_err(|e| e.to_string())?;
     let out = &args.out;
     capture::fresh_folder(out)?;
     capture::write_object(&object, &out.join("object"))?;

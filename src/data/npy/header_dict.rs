@@ -1,5 +1,5 @@
 //! The Python literal subset of `.npy` header dicts: strings, booleans, whole numbers, tuples and `None`,
-//! read by a small recursive-descent parser (errors as text, turned into a `DataError` by the caller).
+//! read by a small recursive-descent parser (its [`DictError`] becomes a `DataError` in the caller).
 
 /// Value of the Python literal subset used by `.npy` headers.
 #[derive(Debug, Clone, PartialEq)]
@@ -9,6 +9,38 @@ pub(super) enum Py {
     Int(u64),
     Tuple(Vec<Py>),
     Other(&'static str),
+}
+
+/// Why the header dict text is not the Python literal subset, with the byte offset where known.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub(super) enum DictError {
+    /// A specific character was needed and another one found.
+    #[error("expected '{want}' at offset {at}, found '{found}'")]
+    Expected { want: char, at: usize, found: char },
+    /// A specific character was needed and the text ended.
+    #[error("expected '{0}', found the end of the header")]
+    ExpectedAtEnd(char),
+    /// A dict key that is not a string.
+    #[error("expected a string key, found {0:?}")]
+    KeyNotString(Py),
+    /// Neither a comma nor the closing bracket `close` after an item.
+    #[error("expected ',' or '{close}' at offset {at}")]
+    Separator { close: char, at: usize },
+    /// Containers nested deeper than the parser follows.
+    #[error("nesting too deep")]
+    TooDeep,
+    /// A string without its closing quote.
+    #[error("unterminated string")]
+    Unterminated,
+    /// A whole number beyond `u64`.
+    #[error("integer too large")]
+    IntegerTooLarge,
+    /// Text that starts no value of the subset.
+    #[error("unexpected text at offset {0}")]
+    UnexpectedText(usize),
+    /// The text ended where a value was needed.
+    #[error("unexpected end of header")]
+    UnexpectedEnd,
 }
 
 /// Recursive-descent parser for the header dict.
@@ -33,24 +65,22 @@ impl<'a> Lit<'a> {
         self.s.get(self.pos).copied()
     }
 
-    fn expect(&mut self, c: u8) -> Result<(), String> {
+    fn expect(&mut self, c: u8) -> Result<(), DictError> {
         match self.peek() {
             Some(x) if x == c => {
                 self.pos += 1;
                 Ok(())
             }
-            Some(x) => Err(format!(
-                "expected '{}' at offset {}, found '{}'",
-                c as char, self.pos, x as char
-            )),
-            None => Err(format!(
-                "expected '{}', found the end of the header",
-                c as char
-            )),
+            Some(x) => Err(DictError::Expected {
+                want: c as char,
+                at: self.pos,
+                found: x as char,
+            }),
+            None => Err(DictError::ExpectedAtEnd(c as char)),
         }
     }
 
-    fn dict(&mut self) -> Result<Vec<(String, Py)>, String> {
+    fn dict(&mut self) -> Result<Vec<(String, Py)>, DictError> {
         self.expect(b'{')?;
         let mut items = Vec::new();
         loop {
@@ -60,7 +90,7 @@ impl<'a> Lit<'a> {
             }
             let key = match self.value(0)? {
                 Py::Str(k) => k,
-                other => return Err(format!("expected a string key, found {other:?}")),
+                other => return Err(DictError::KeyNotString(other)),
             };
             self.expect(b':')?;
             let value = self.value(0)?;
@@ -68,14 +98,19 @@ impl<'a> Lit<'a> {
             match self.peek() {
                 Some(b',') => self.pos += 1,
                 Some(b'}') => {}
-                _ => return Err(format!("expected ',' or '}}' at offset {}", self.pos)),
+                _ => {
+                    return Err(DictError::Separator {
+                        close: '}',
+                        at: self.pos,
+                    });
+                }
             }
         }
     }
 
-    fn value(&mut self, depth: usize) -> Result<Py, String> {
+    fn value(&mut self, depth: usize) -> Result<Py, DictError> {
         if depth > 8 {
-            return Err("nesting too deep".into());
+            return Err(DictError::TooDeep);
         }
         match self.peek() {
             Some(q @ (b'\'' | b'"')) => {
@@ -84,9 +119,8 @@ impl<'a> Lit<'a> {
                 while self.s.get(self.pos).is_some_and(|&c| c != q) {
                     self.pos += 1;
                 }
-                let text = self.s.get(start..self.pos).ok_or("unterminated string")?;
-                self.expect(q)
-                    .map_err(|_| "unterminated string".to_string())?;
+                let text = self.s.get(start..self.pos).ok_or(DictError::Unterminated)?;
+                self.expect(q).map_err(|_| DictError::Unterminated)?;
                 Ok(Py::Str(String::from_utf8_lossy(text).into_owned()))
             }
             Some(open @ (b'(' | b'[')) => {
@@ -107,10 +141,10 @@ impl<'a> Lit<'a> {
                         Some(b',') => self.pos += 1,
                         Some(c) if c == close => {}
                         _ => {
-                            return Err(format!(
-                                "expected ',' or '{}' at offset {}",
-                                close as char, self.pos
-                            ));
+                            return Err(DictError::Separator {
+                                close: close as char,
+                                at: self.pos,
+                            });
                         }
                     }
                 }
@@ -125,7 +159,7 @@ impl<'a> Lit<'a> {
                     n = n
                         .checked_mul(10)
                         .and_then(|n| n.checked_add(u64::from(d - b'0')))
-                        .ok_or("integer too large")?;
+                        .ok_or(DictError::IntegerTooLarge)?;
                     self.pos += 1;
                 }
                 // Python 2 wrote long integers as `480L`.
@@ -146,14 +180,14 @@ impl<'a> Lit<'a> {
                         return Ok(v);
                     }
                 }
-                Err(format!("unexpected text at offset {}", self.pos))
+                Err(DictError::UnexpectedText(self.pos))
             }
-            None => Err("unexpected end of header".into()),
+            None => Err(DictError::UnexpectedEnd),
         }
     }
 }
 
 /// Parses the header dict text `{'descr': ..., 'fortran_order': ..., 'shape': (...), }` into its entries.
-pub(super) fn parse_dict(text: &[u8]) -> Result<Vec<(String, Py)>, String> {
+pub(super) fn parse_dict(text: &[u8]) -> Result<Vec<(String, Py)>, DictError> {
     Lit { s: text, pos: 0 }.dict()
 }

@@ -10,6 +10,19 @@ use crate::articulation::vertex_motion::VertexMotionWeights;
 use crate::fit::preset::{Budget, Preset};
 use crate::loss::LossWeights;
 
+/// A command-line option value that names no known setting: what it should name, the value given
+/// (quoted), and the valid values.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[error("unknown {what} {name:?}: expected {expected}")]
+pub struct UnknownOption {
+    /// What the value names, e.g. `ablation`.
+    pub what: &'static str,
+    /// The value given.
+    pub name: String,
+    /// The valid values, as a phrase.
+    pub expected: &'static str,
+}
+
 /// Which parts of the motion-consistency objective are on (the paper's Table 4 ablations; the
 /// fourth, part-aware remeshing, is the reconstruction's `RemeshMode`).
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -32,7 +45,7 @@ impl Ablation {
 
     /// The ablation named as on the command line (`full`, `no-vertex-color`, `no-vertex-opacity`,
     /// `no-backward`).
-    pub fn parse(name: &str) -> Result<Ablation, String> {
+    pub fn parse(name: &str) -> Result<Ablation, UnknownOption> {
         let full = Ablation::FULL;
         Ok(match name {
             "full" => full,
@@ -49,9 +62,11 @@ impl Ablation {
                 ..full
             },
             other => {
-                return Err(format!(
-                    "unknown ablation {other:?}: expected full, no-vertex-color, no-vertex-opacity or no-backward"
-                ));
+                return Err(UnknownOption {
+                    what: "ablation",
+                    name: other.to_string(),
+                    expected: "full, no-vertex-color, no-vertex-opacity or no-backward",
+                });
             }
         })
     }
@@ -86,14 +101,16 @@ pub enum GeometryUse {
 
 impl GeometryUse {
     /// The mode named as on the command line (`off`, `seed`, `settle`).
-    pub fn parse(name: &str) -> Result<GeometryUse, String> {
+    pub fn parse(name: &str) -> Result<GeometryUse, UnknownOption> {
         match name {
             "off" => Ok(GeometryUse::Off),
             "seed" => Ok(GeometryUse::Seed),
             "settle" => Ok(GeometryUse::Settle),
-            other => Err(format!(
-                "unknown geometry mode {other:?}: expected off, seed or settle"
-            )),
+            other => Err(UnknownOption {
+                what: "geometry mode",
+                name: other.to_string(),
+                expected: "off, seed or settle",
+            }),
         }
     }
 }

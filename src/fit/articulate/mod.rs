@@ -43,7 +43,7 @@ mod results;
 mod run;
 mod ssim;
 
-pub use config::{Ablation, ArticulationConfig, GeometryUse, RefineViews};
+pub use config::{Ablation, ArticulationConfig, GeometryUse, RefineViews, UnknownOption};
 pub use results::{Articulation, ArticulationPoint, ArticulationTimes, BakeOff, FittedJoint};
 
 use glam::DVec3;
@@ -91,17 +91,17 @@ pub async fn articulate(
     let mut warnings = Vec::new();
     let [s1, s2] = frozen_states(rec)?;
     let k = rec.num_parts;
-    let views1 =
-        training_views(dataset, State::Start, &rec.config).map_err(GpuError::InvalidInput)?;
-    let views2 =
-        training_views(dataset, State::End, &rec.config).map_err(GpuError::InvalidInput)?;
+    let views1 = training_views(dataset, State::Start, &rec.config)
+        .map_err(|e| GpuError::InvalidInput(e.to_string()))?;
+    let views2 = training_views(dataset, State::End, &rec.config)
+        .map_err(|e| GpuError::InvalidInput(e.to_string()))?;
     let kernels = MotionKernels::new(ctx);
     // Forward: state t₁'s mesh, moved by g⁺, against state t₂'s views; backward the reverse.
     let forward = MovedView::new(ctx, &kernels, &s1.field, &s1.parts, &views2)?;
     let backward = MovedView::new(ctx, &kernels, &s2.field, &s2.parts, &views1)?;
     let surfaces = [
-        StateSurface::from_field(&s1.field).map_err(GpuError::InvalidInput)?,
-        StateSurface::from_field(&s2.field).map_err(GpuError::InvalidInput)?,
+        StateSurface::from_field(&s1.field).map_err(|e| GpuError::InvalidInput(e.to_string()))?,
+        StateSurface::from_field(&s2.field).map_err(|e| GpuError::InvalidInput(e.to_string()))?,
     ];
     let renderer = MotionRenderer::new(ctx, kernels, &rec.config, config);
     let center = principal_frame(&s1.field.positions).map_or(DVec3::ZERO, |f| f.centroid);

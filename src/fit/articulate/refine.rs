@@ -52,13 +52,13 @@ fn vertex_term(
         return Ok((vf, vb, None));
     }
     let [surface1, surface2] = surfaces;
-    let f =
-        vertex_motion_loss(surface1, surface2, g_fwd, weights).map_err(GpuError::InvalidInput)?;
+    let f = vertex_motion_loss(surface1, surface2, g_fwd, weights)
+        .map_err(|e| GpuError::InvalidInput(e.to_string()))?;
     let mut total = f.loss;
     vf = f.per_part;
     if config.ablation.backward {
         let b = vertex_motion_loss(surface2, surface1, g_bwd, weights)
-            .map_err(GpuError::InvalidInput)?;
+            .map_err(|e| GpuError::InvalidInput(e.to_string()))?;
         total += b.loss;
         vb = b.per_part;
     }

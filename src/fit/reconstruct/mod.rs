@@ -37,17 +37,22 @@ use crate::data::{Dataset, Frame, Split, State};
 use crate::fit::observer::Observer;
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 
+/// A state of the dataset without training views, so there is nothing to fit.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
+#[error("the dataset has no {} training views", .0.name())]
+pub struct NoTrainingViews(pub State);
+
 /// The training views of `state` under `config`: evenly spaced, downsampled.
 pub fn training_views(
     dataset: &Dataset,
     state: State,
     config: &ReconstructionConfig,
-) -> Result<Vec<Frame>, String> {
+) -> Result<Vec<Frame>, NoTrainingViews> {
     let frames = dataset
         .views(state, Split::Train)
         .map(|v| &v.frames)
         .filter(|f| !f.is_empty())
-        .ok_or_else(|| format!("the dataset has no {} training views", state.name()))?;
+        .ok_or(NoTrainingViews(state))?;
     let n = frames.len();
     let take = if config.max_views == 0 {
         n
@@ -74,7 +79,8 @@ pub async fn reconstruct(
 ) -> GpuResult<Reconstruction> {
     let mut states = Vec::new();
     for state in [State::Start, State::End] {
-        let frames = training_views(dataset, state, config).map_err(GpuError::InvalidInput)?;
+        let frames = training_views(dataset, state, config)
+            .map_err(|e| GpuError::InvalidInput(e.to_string()))?;
         states.push(
             reconstruct_state(ctx, state, &frames, dataset.num_parts, config, observer).await?,
         );

@@ -10,6 +10,26 @@ use crate::object::mesh_io::join_relative;
 
 use super::reader::{Reader, child};
 
+/// Why a `package://NAME/...` reference names no single package folder.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+enum PackageError {
+    /// No `package.xml` declares the name.
+    #[error(
+        "no package.xml in the dataset declares <name>{0}</name> (needed for package://{0}/...)"
+    )]
+    Undeclared(String),
+    /// Several do, and none of their folders contains the URDF.
+    #[error(
+        "package '{name}' is declared by several package.xml files ({folders}) and none contains the URDF"
+    )]
+    Ambiguous {
+        /// The package name.
+        name: String,
+        /// The declaring folders, comma-separated.
+        folders: String,
+    },
+}
+
 impl Reader<'_, '_> {
     /// Resolves a URDF file reference to a key of the file set.
     pub(super) fn resolve(
@@ -26,7 +46,9 @@ impl Reader<'_, '_> {
                     format!("expected 'package://NAME/path', found {filename:?}"),
                 ));
             };
-            let folder = self.package_folder(package).map_err(|m| bad(self, m))?;
+            let folder = self
+                .package_folder(package)
+                .map_err(|m| bad(self, m.to_string()))?;
             return join_relative(&folder, rel)
                 .ok_or_else(|| bad(self, format!("'{filename}' leaves the dataset folder")));
         }
@@ -59,14 +81,12 @@ impl Reader<'_, '_> {
 
     /// Folder (with trailing '/') of the package named `name`: the `package.xml` declaring it; when several do,
     /// the one closest above the URDF.
-    fn package_folder(&mut self, name: &str) -> Result<String, String> {
+    fn package_folder(&mut self, name: &str) -> Result<String, PackageError> {
         let packages = self
             .packages
             .get_or_insert_with(|| find_packages(self.files));
         let Some(folders) = packages.get(name) else {
-            return Err(format!(
-                "no package.xml in the dataset declares <name>{name}</name> (needed for package://{name}/...)"
-            ));
+            return Err(PackageError::Undeclared(name.to_string()));
         };
         let above: Vec<&String> = folders
             .iter()
@@ -75,10 +95,10 @@ impl Reader<'_, '_> {
         match (folders.as_slice(), above.iter().max_by_key(|f| f.len())) {
             ([only], _) => Ok(only.clone()),
             (_, Some(best)) => Ok((*best).clone()),
-            _ => Err(format!(
-                "package '{name}' is declared by several package.xml files ({}) and none contains the URDF",
-                folders.join(", ")
-            )),
+            _ => Err(PackageError::Ambiguous {
+                name: name.to_string(),
+                folders: folders.join(", "),
+            }),
         }
     }
 }

@@ -56,7 +56,8 @@ pub fn capture(ctx: &GpuContext, sizes: &[u32], views: usize) -> Result<CaptureB
         category: Category::StorageFurniture,
         movable_parts: Some(6),
         seed: 1,
-    })?;
+    })
+    .map_err(|e| e.to_string())?;
     let triangles = (0..object.links.len())
         .flat_map(|l| object.link_meshes(l))
         .map(|m| m.indices.len())

@@ -70,7 +70,7 @@ pub fn run(args: &FitBenchArgs) -> Result<String, String> {
         config.articulation.iterations = n;
     }
     if let Some(g) = &args.geometry {
-        config.articulation.geometry = GeometryUse::parse(g)?;
+        config.articulation.geometry = GeometryUse::parse(g).map_err(|e| e.to_string())?;
     }
     if let Some(path) = &args.markdown {
         fresh_file(path)?;
@@ -320,7 +320,7 @@ fn ablate(
     let named = |e: String| format!("{}: {e}", object.id);
     for (run, (_, name)) in runs[1..].iter_mut().zip(ARTICULATION_ABLATIONS) {
         let articulation = ArticulationConfig {
-            ablation: Ablation::parse(name)?,
+            ablation: Ablation::parse(name).map_err(|e| e.to_string())?,
             ..config.articulation
         };
         fit.articulation = pollster::block_on(articulate(

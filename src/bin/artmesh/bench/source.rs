@@ -93,7 +93,9 @@ impl SuiteSource {
             (SuiteSource::Capture { size, views, .. }, Some(entry)) => {
                 capture_entry(ctx, entry, *size, *views, 2)
             }
-            (SuiteSource::Dir(dir), _) => read_dataset(&dir.join(&object.id)),
+            (SuiteSource::Dir(dir), _) => {
+                read_dataset(&dir.join(&object.id)).map_err(|e| e.to_string())
+            }
             _ => Err(format!("{}: no capture plan", object.id)),
         }
     }

@@ -43,7 +43,7 @@ pub struct SpreadArgs {
 pub fn run(args: &SpreadArgs) -> Result<String, String> {
     let config = fit_config(&args.preset)?;
     let change = SpreadChange::parse(&args.vary)?;
-    let dataset = read_dataset(&args.dataset)?;
+    let dataset = read_dataset(&args.dataset).map_err(|e| e.to_string())?;
     let ctx = context()?;
     let runs = args.runs as usize;
     let report = spread(
