@@ -187,10 +187,6 @@ function readDemoForm() {
 
 async function runDemo() {
   if (busy || broken) return;
-  busy = true;
-  updateButtons();
-  hideBanner();
-  clearResult();
   const { category, parts, preset, seed } = readDemoForm();
   const status = $("demo-status");
   let budget;
@@ -199,10 +195,12 @@ async function runDemo() {
   } catch (e) {
     status.textContent = `Check the budgets: ${errorText(e)}`;
     showBanner(`Check the budgets (Advanced: budgets): ${errorText(e)}`);
-    busy = false;
-    updateButtons();
     return;
   }
+  busy = true;
+  updateButtons();
+  hideBanner();
+  clearResult();
   const progress = $("demo-progress");
   progress.hidden = false;
   progress.value = 0;
