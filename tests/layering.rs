@@ -317,12 +317,13 @@ fn resolve(
             continue;
         }
         // An item: defined here, or brought in by a `use` we follow (re-exports).
-        if depth < 8 && !defines(&scans[&at].code, seg) {
-            if let Some(u) = scans[&at].uses.iter().find(|u| u.last() == Some(seg)) {
-                let mut full = u.clone();
-                full.extend(segs[k + 1..].iter().cloned());
-                return resolve(tree, scans, &at, &full, depth + 1).or(Some(at));
-            }
+        if depth < 8
+            && !defines(&scans[&at].code, seg)
+            && let Some(u) = scans[&at].uses.iter().find(|u| u.last() == Some(seg))
+        {
+            let mut full = u.clone();
+            full.extend(segs[k + 1..].iter().cloned());
+            return resolve(tree, scans, &at, &full, depth + 1).or(Some(at));
         }
         return Some(at);
     }
@@ -370,10 +371,12 @@ fn file_graph(tree: &Tree) -> BTreeMap<String, BTreeSet<String>> {
     {
         let edges: &mut BTreeSet<String> = graph.entry(f.clone()).or_default();
         for path in s.imports.iter().chain(inline_paths(&s.code).iter()) {
-            if let Some(to) = resolve(tree, &scans, f, path, 0) {
-                if to != *f && to != "lib.rs" && !test_files.contains(&to) {
-                    edges.insert(to);
-                }
+            if let Some(to) = resolve(tree, &scans, f, path, 0)
+                && to != *f
+                && to != "lib.rs"
+                && !test_files.contains(&to)
+            {
+                edges.insert(to);
             }
         }
     }

@@ -6,6 +6,7 @@ import { $, show, errorText, showBanner, hideBanner, freeQuietly } from "./util.
 import { setupInput, showDataset } from "./input.js";
 import { wireFitButtons, runFit, markFitDone } from "./fit-ui.js";
 import { wireResultButtons, showResult, clearResult } from "./result-ui.js";
+import { setupBudgets, showPresetBudget, budgetOverrides } from "./budget-ui.js";
 
 const params = new URLSearchParams(location.search);
 const maxSize = Number(params.get("max") ?? 1000003);
@@ -147,8 +148,11 @@ function fillForms() {
       about.textContent = catalogue.presets.find((p) => p.name === select.value)?.about ?? "";
     };
     select.addEventListener("change", describe);
+    // The budgets section follows the preset chosen last.
+    select.addEventListener("change", () => showPresetBudget(select.value));
     describe();
   }
+  setupBudgets(catalogue.presets, preset, (name, overrides) => JSON.parse(wasm.preset_budget(name, overrides)).about);
   const setRange = (parts) => {
     const c = catalogue.categories.find((c) => c.name === cat.value);
     const [lo, hi] = c?.parts ?? [1, 15];
@@ -183,12 +187,20 @@ function readDemoForm() {
 
 async function runDemo() {
   if (busy || broken) return;
+  const { category, parts, preset, seed } = readDemoForm();
+  const status = $("demo-status");
+  let budget;
+  try {
+    budget = budgetOverrides(preset);
+  } catch (e) {
+    status.textContent = `Check the budgets: ${errorText(e)}`;
+    showBanner(`Check the budgets (Advanced: budgets): ${errorText(e)}`);
+    return;
+  }
   busy = true;
   updateButtons();
   hideBanner();
   clearResult();
-  const { category, parts, preset, seed } = readDemoForm();
-  const status = $("demo-status");
   const progress = $("demo-progress");
   progress.hidden = false;
   progress.value = 0;
@@ -201,7 +213,7 @@ async function runDemo() {
         if (!p || !(p.total > 0)) return;
         progress.value = p.done / p.total;
         status.textContent = `Photographing the object: ${p.done} of ${p.total} views rendered.`;
-      });
+      }, budget);
     } catch (e) {
       document.body.dataset.demo = "error";
       status.textContent = `The demo object could not be made: ${errorText(e)}`;
@@ -212,7 +224,7 @@ async function runDemo() {
     document.body.dataset.demo = "rendered";
     status.textContent = "Photographed; now fitting (see Fit).";
     setDataset(ds);
-    await doFit(ds, preset, `the demo ${category}`);
+    await doFit(ds, preset, budget, `the demo ${category}`);
     status.textContent = document.body.dataset.fit === "done" ? "Done: the twin is under Result."
       : "The fit did not finish: see Fit.";
   } finally {
@@ -223,7 +235,8 @@ async function runDemo() {
 
 // --- 3. + 4. fit and result ---------------------------------------------------------------
 
-async function doFit(ds, preset, what) {
+/** Fits `ds` with `preset` and `budget` (the budgets' overrides as JSON, or undefined). */
+async function doFit(ds, preset, budget, what) {
   clearResult();
   delete window.artmeshLast;
   $("fit").scrollIntoView?.({ behavior: "smooth", block: "start" });
@@ -235,7 +248,7 @@ async function doFit(ds, preset, what) {
     document.body.dataset.fit = "error";
     return;
   }
-  const r = await runFit(wasm.fit, handle, preset, what);
+  const r = await runFit(wasm.fit, handle, preset, budget, what);
   if (!r) {
     $("result-empty").textContent = "No twin: the fit did not finish.";
     return;
@@ -261,7 +274,15 @@ async function fitCurrent() {
   try {
     let name = "your dataset";
     try { name = currentDataset.name() || name; } catch { /* unnamed */ }
-    await doFit(currentDataset, $("fit-preset").value, name);
+    const preset = $("fit-preset").value;
+    let budget;
+    try {
+      budget = budgetOverrides(preset);
+    } catch (e) {
+      showBanner(`Check the budgets (Advanced: budgets): ${errorText(e)}`);
+      return;
+    }
+    await doFit(currentDataset, preset, budget, name);
   } finally {
     busy = false;
     updateButtons();
@@ -278,7 +299,7 @@ async function main() {
     } catch (e) {
       throw new Error(`the wasm module (web/pkg) did not load: ${errorText(e)}; build it with web/build.sh`);
     }
-    const missing = ["adapter_report", "gpu_self_test", "catalogue", "fit", "Dataset", "Viewer"].filter((n) => !wasm[n]);
+    const missing = ["adapter_report", "gpu_self_test", "catalogue", "preset_budget", "fit", "Dataset", "Viewer"].filter((n) => !wasm[n]);
     if (missing.length) throw new Error(`web/pkg is out of date (missing ${missing.join(", ")}): rebuild it with web/build.sh`);
     await wasm.default();
     catalogue = JSON.parse(wasm.catalogue());

@@ -150,14 +150,16 @@ export const fitRunning = () => running;
 
 /** Resolves to the hint shown after a fit error (or ""). */
 function hintFor(message) {
-  return /memory|limit|binding|too many/i.test(message) ? "\nTry a smaller preset (tiny or fast)." : "";
+  return /memory|limit|binding|too many/i.test(message)
+    ? "\nTry a smaller preset (tiny or fast) or smaller budgets (Advanced: budgets)." : "";
 }
 
 /**
- * Runs `fitFn(datasetHandle, preset, onEvent, control)`; the handle is consumed.
+ * Runs `fitFn(datasetHandle, preset, onEvent, control, budget)`; the handle is consumed. `budget`
+ * is the budgets' overrides as JSON (undefined: the preset's own).
  * Resolves to the FitResult, or null when cancelled or failed (the panel says which).
  */
-export async function runFit(fitFn, datasetHandle, preset, what) {
+export async function runFit(fitFn, datasetHandle, preset, budget, what) {
   running = true;
   control = "run";
   resetPanel();
@@ -165,10 +167,11 @@ export async function runFit(fitFn, datasetHandle, preset, what) {
   $("pause").disabled = false;
   $("cancel").disabled = false;
   setFit("running");
-  show($("fit-status"), `Starting the fit of ${what} (preset ${preset})…`);
+  const changes = budget ? Object.entries(JSON.parse(budget)).map(([k, v]) => `${k} ${v}`).join(", ") : "";
+  show($("fit-status"), `Starting the fit of ${what} (preset ${preset}${changes ? `; ${changes}` : ""})…`);
   const t0 = performance.now();
   try {
-    const result = await fitFn(datasetHandle, preset, onEvent, () => control);
+    const result = await fitFn(datasetHandle, preset, onEvent, () => control, budget);
     running = false;
     dirty = true;
     update();

@@ -7,12 +7,12 @@ use std::rc::Rc;
 use js_sys::{Array, Function, Object, Reflect, Uint8ClampedArray};
 use wasm_bindgen::prelude::*;
 
-use super::{context, js_error};
+use super::{budget, context, js_error};
 use crate::data::{Dataset, FileSet, Split, State, read_zip, rebase_on_dataset_root};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
 use crate::fit::observer::{Command, Observer, Preview};
-use crate::fit::reconstruct::{Preset, Progress};
+use crate::fit::reconstruct::Progress;
 use crate::gpu::now_seconds;
 use crate::pipeline::{self, FitInput, PipelineError};
 use crate::synth::Category;
@@ -61,7 +61,8 @@ fn file_set(paths: Vec<String>, contents: Vec<js_sys::Uint8Array>) -> Result<Fil
         .collect())
 }
 
-/// The demo's choices as JSON: categories with their part counts, presets, defaults.
+/// The demo's choices as JSON: categories with their part counts, presets (`Preset::ALL`, each
+/// with its budget, see `preset_budget`), defaults.
 #[wasm_bindgen]
 pub fn catalogue() -> String {
     let categories: Vec<_> = Category::ALL
@@ -76,29 +77,9 @@ pub fn catalogue() -> String {
             })
         })
         .collect();
-    let presets: Vec<_> = [Preset::Tiny, Preset::Fast, Preset::Paper]
-        .into_iter()
-        .map(|p| {
-            let c = FitConfig::preset(p);
-            let rec = &c.reconstruction;
-            let size = if rec.max_size == 0 {
-                "full-size".to_string()
-            } else {
-                format!("{} px", rec.max_size)
-            };
-            serde_json::json!({
-                "name": p.name(),
-                "about": format!(
-                    "{size}, {} iterations per state + {} for the joints",
-                    rec.fit.iterations + rec.recovery_iterations,
-                    c.articulation.iterations
-                ),
-            })
-        })
-        .collect();
     serde_json::json!({
         "categories": categories,
-        "presets": presets,
+        "presets": budget::preset_entries(),
         "default": {"category": Category::StorageFurniture.slug(), "parts": 2, "preset": "fast", "seed": 0},
     })
     .to_string()
@@ -141,17 +122,19 @@ impl WebDataset {
     }
 
     /// Generates the procedural `category` object with `parts` movable parts from `seed` and
-    /// captures both states as the `preset`'s demo does (`artmesh demo`); `on_progress` hears
-    /// `{done, total}` views.
+    /// captures both states as the `preset`'s demo does (`artmesh demo`), at the working size
+    /// and views per state of `budget` (the preset's budget overrides as JSON, optional: see
+    /// `fit`); `on_progress` hears `{done, total}` views.
     pub async fn demo(
         category: String,
         parts: u32,
         preset: String,
         seed: u32,
         on_progress: Function,
+        budget: Option<String>,
     ) -> Result<WebDataset, JsError> {
         let category = Category::parse(&category).map_err(js_error)?;
-        let config = FitConfig::preset(Preset::parse(&preset).map_err(js_error)?);
+        let config = budget::fit_config(&preset, budget.as_deref()).map_err(js_error)?;
         let object =
             pipeline::demo::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
         let ctx = context().await?;
@@ -283,15 +266,19 @@ impl Observer for PageObserver {
 
 /// Fits `dataset` with `preset` on the page's GPU (reconstruction of both states, then
 /// articulation), telling `on_event` about progress and previews and asking `control` whether
-/// to go on. Rejects with a message starting "cancelled" when cancelled.
+/// to go on. `budget` (optional) overrides some of the preset's budget, as JSON with any of
+/// `max_size`, `max_views`, `reconstruction_iterations`, `recovery_iterations`, `max_faces`,
+/// `articulation_iterations` (what the CLI's flags of those names set). Rejects with a message
+/// starting "cancelled" when cancelled.
 #[wasm_bindgen]
 pub async fn fit(
     dataset: WebDataset,
     preset: String,
     on_event: Function,
     control: Function,
+    budget: Option<String>,
 ) -> Result<FitResult, JsError> {
-    let config = FitConfig::preset(Preset::parse(&preset).map_err(js_error)?);
+    let config = budget::fit_config(&preset, budget.as_deref()).map_err(js_error)?;
     let ctx = context().await?;
     let mut observer = PageObserver {
         config,

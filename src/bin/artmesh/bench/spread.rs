@@ -267,7 +267,7 @@ fn spread_run(
         seconds: start.elapsed().as_secs_f64(),
         psnr_optimised: states.iter().map(|s| s.psnr_optimised).collect(),
         remeshed_faces: states.iter().map(|s| s.remesh.faces_built).collect(),
-        joints: artmesh::export::joint_records(&fit),
+        joints: artmesh::export::joint_records(fit),
         gt_errors: against_gt(&fitted),
         seed_gt_errors: seeds_gt,
     };
