@@ -177,7 +177,7 @@ fn rms(res: &[Residual]) -> f64 {
 /// Returns the motion unchanged, and no report, when the motion has no direction to follow or the
 /// part has too few matches; unchanged with a report (`applied: false`) when the part's geometry
 /// barely sees its motion ([`MIN_OBSERVABILITY`]) or registering raises the residual.
-pub fn register_along_axis(
+pub(crate) fn register_along_axis(
     motion: PartMotion,
     kind: JointKind,
     start: &StateSurface,

@@ -37,13 +37,13 @@ use super::observed::PartCloud;
 use crate::data::JointKind;
 
 /// The prismatic model wins while its residual is at most this many times the revolute one.
-pub const PRISMATIC_SLACK: f64 = 1.2;
+pub(crate) const PRISMATIC_SLACK: f64 = 1.2;
 
 /// Decisions with a margin under this are flagged.
-pub const SMALL_MARGIN: f64 = 0.5;
+pub(crate) const SMALL_MARGIN: f64 = 0.5;
 
 /// Fewer points than this in either state: the part is too small in the data to fit here.
-pub const MIN_POINTS: usize = 30;
+pub(crate) const MIN_POINTS: usize = 30;
 
 /// One movable part's geometric fit.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -77,7 +77,7 @@ impl GeometricJoint {
 
     /// Whether the data settle this joint: both states measured, the motion visible and the
     /// type picked by a clear margin.
-    pub fn settled(&self) -> bool {
+    pub(crate) fn settled(&self) -> bool {
         self.observable
             && self.margin >= SMALL_MARGIN
             && self.points.iter().all(|&n| n >= MIN_POINTS)

@@ -16,7 +16,7 @@ use crate::mesh::spatial::KdTree;
 
 /// Eigen-decomposition of a symmetric n × n matrix by cyclic Jacobi rotations: eigenvalues in
 /// decreasing order and the matching unit eigenvectors.
-pub fn symmetric_eigen<const N: usize>(mut a: [[f64; N]; N]) -> ([f64; N], [[f64; N]; N]) {
+pub(crate) fn symmetric_eigen<const N: usize>(mut a: [[f64; N]; N]) -> ([f64; N], [[f64; N]; N]) {
     let mut v = [[0.0; N]; N];
     for (i, row) in v.iter_mut().enumerate() {
         row[i] = 1.0;
@@ -202,7 +202,7 @@ pub struct JointCandidates {
 impl JointCandidates {
     /// Whether staying put fits about as well as the best registration: the part's motion is
     /// below what the two reconstructions resolve.
-    pub fn barely_moves(&self) -> bool {
+    pub(crate) fn barely_moves(&self) -> bool {
         let best = self.registration.residual.min(self.prismatic_residual);
         self.identity_residual <= 1.25 * best + SAME_FIT
     }
@@ -216,7 +216,7 @@ const SAME_FIT: f64 = 0.002;
 
 /// Seeds both candidates of a part seen as `start` (state t₁ vertices) and `end` (state t₂);
 /// `None` when either state has fewer than 3 vertices of the part.
-pub fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCandidates> {
+pub(crate) fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCandidates> {
     let f1 = principal_frame(start)?;
     let f2 = principal_frame(end)?;
     let tree = KdTree::new(end);

@@ -47,7 +47,7 @@ impl PartAffine {
 }
 
 /// The two kernels, built once and shared by both states.
-pub struct MotionKernels {
+pub(crate) struct MotionKernels {
     family: KernelFamily,
     apply: wgpu::ComputePipeline,
     reduce: wgpu::ComputePipeline,
@@ -80,7 +80,7 @@ impl MotionKernels {
 
 /// One state's frozen mesh as the pixel-wise term moves it into the other state: its rest
 /// positions and hardened part labels, bound to the field whose positions it overwrites.
-pub struct MovedMesh {
+pub(crate) struct MovedMesh {
     motions: wgpu::Buffer,
     partials: wgpu::Buffer,
     bind_group: wgpu::BindGroup,
@@ -159,7 +159,7 @@ impl MovedMesh {
     }
 
     /// Records the move of every vertex by its part's `(A, b)` (one per part; missing parts stay).
-    pub fn encode_apply(
+    pub(crate) fn encode_apply(
         &self,
         ctx: &GpuContext,
         kernels: &MotionKernels,
@@ -188,7 +188,7 @@ impl MovedMesh {
     }
 
     /// Records the per-part reduction of the field's position gradients (after a backward pass).
-    pub fn encode_reduce(
+    pub(crate) fn encode_reduce(
         &self,
         ctx: &GpuContext,
         kernels: &MotionKernels,
@@ -204,7 +204,7 @@ impl MovedMesh {
     }
 
     /// The per-part sums of the last reduction, added up in f64 over workgroups.
-    pub async fn read_sums(&self, ctx: &GpuContext) -> GpuResult<Vec<PartSums>> {
+    pub(crate) async fn read_sums(&self, ctx: &GpuContext) -> GpuResult<Vec<PartSums>> {
         let k = self.num_parts as usize;
         let groups = self.num_vertices.div_ceil(REDUCE_SPAN).max(1) as usize;
         let partials: Vec<f32> = ctx

@@ -71,13 +71,13 @@ impl PartMotion {
     }
 
     /// (R, b) of g⁺(x) = R x + b, with b = −R P + P + T.
-    pub fn forward_affine(&self) -> (DMat3, DVec3) {
+    pub(crate) fn forward_affine(&self) -> (DMat3, DVec3) {
         let r = DMat3::from_quat(self.rotation.normalize());
         (r, self.pivot - r * self.pivot + self.translation)
     }
 
     /// (Rᵀ, −Rᵀ b) of g⁻ = (g⁺)⁻¹.
-    pub fn backward_affine(&self) -> (DMat3, DVec3) {
+    pub(crate) fn backward_affine(&self) -> (DMat3, DVec3) {
         let (r, b) = self.forward_affine();
         let rt = r.transpose();
         (rt, -(rt * b))
@@ -122,7 +122,7 @@ impl PartMotion {
     /// The joint's unit axis and magnitude: a revolute motion's rotation axis and angle
     /// (radians, in [0, π]), a prismatic one's slide direction and distance (m). A motion too
     /// small to have a direction gets the z axis and (about) 0.
-    pub fn axis_and_magnitude(&self, kind: JointKind) -> (DVec3, f64) {
+    pub(crate) fn axis_and_magnitude(&self, kind: JointKind) -> (DVec3, f64) {
         match kind {
             JointKind::Revolute => rotation_axis_angle(self.rotation),
             JointKind::Prismatic => {
@@ -163,7 +163,7 @@ impl PartMotion {
 
 /// The unit axis and angle (radians, in [0, π]) of a rotation; the angle's sign goes into the
 /// axis. A rotation closer to identity than floating point resolves gets the z axis.
-pub fn rotation_axis_angle(q: DQuat) -> (DVec3, f64) {
+pub(crate) fn rotation_axis_angle(q: DQuat) -> (DVec3, f64) {
     let q = q.normalize();
     // q and −q are the same rotation: take w ≥ 0 so the angle stays in [0, π].
     let q = if q.w < 0.0 { -q } else { q };
@@ -176,7 +176,7 @@ pub fn rotation_axis_angle(q: DQuat) -> (DVec3, f64) {
 }
 
 /// The point of the line through `origin` along unit `dir` closest to `p`.
-pub fn closest_on_line(origin: DVec3, dir: DVec3, p: DVec3) -> DVec3 {
+pub(crate) fn closest_on_line(origin: DVec3, dir: DVec3, p: DVec3) -> DVec3 {
     origin + dir * (p - origin).dot(dir)
 }
 
@@ -217,7 +217,7 @@ impl MotionMask {
         translation: true,
     };
     /// Nothing trained (the static base).
-    pub const NONE: MotionMask = MotionMask {
+    pub(crate) const NONE: MotionMask = MotionMask {
         rotation: false,
         pivot: false,
         translation: false,
@@ -296,7 +296,7 @@ impl MotionAdam {
     }
 
     /// Scales every learning rate to `factor` × the initial ones (a decay schedule).
-    pub fn set_scale(&mut self, factor: f64) {
+    pub(crate) fn set_scale(&mut self, factor: f64) {
         self.scale = factor;
     }
 

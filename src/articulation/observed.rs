@@ -238,7 +238,7 @@ fn voxelise(samples: &[&Sample], edge: f32) -> PartCloud {
 }
 
 /// Both states' measured part surfaces from their frames (`frames[0]` start, `frames[1]` end).
-pub fn observe_states(
+pub(crate) fn observe_states(
     frames: [&[Frame]; 2],
     num_parts: usize,
     options: &CloudOptions,

@@ -57,6 +57,6 @@ impl PartSums {
 }
 
 /// a bᵀ.
-pub fn outer(a: DVec3, b: DVec3) -> DMat3 {
+pub(crate) fn outer(a: DVec3, b: DVec3) -> DMat3 {
     DMat3::from_cols(a * b.x, a * b.y, a * b.z)
 }

@@ -144,7 +144,7 @@ impl StateSurface {
 
     /// The state surface of a mesh field: hardened part labels, view-independent (degree-0 SH)
     /// colour and sigmoid opacity.
-    pub fn from_field(field: &MeshField) -> Result<Self, SurfaceError> {
+    pub(crate) fn from_field(field: &MeshField) -> Result<Self, SurfaceError> {
         field.validate()?;
         let parts = crate::mesh::topology::harden_parts(field);
         let colors = (0..field.num_vertices())
@@ -212,7 +212,7 @@ impl StateSurface {
 
     /// The point of `part`'s faces closest to `q` and that face's unit normal (either side);
     /// `None` for a part without faces or when the closest face is degenerate.
-    pub fn closest_with_normal(&self, part: usize, q: DVec3) -> Option<(DVec3, DVec3)> {
+    pub(crate) fn closest_with_normal(&self, part: usize, q: DVec3) -> Option<(DVec3, DVec3)> {
         let hit = self.part_trees.get(part)?.closest(q.as_vec3())?;
         let face = self.faces[self.part_faces[part][hit.face as usize] as usize];
         let [a, b, c] = face.map(|v| self.positions[v as usize].as_dvec3());

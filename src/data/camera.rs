@@ -45,7 +45,7 @@ impl Intrinsics {
     }
 
     /// Vertical field of view in radians (`camera_angle_y`).
-    pub fn fov_y(&self) -> f32 {
+    pub(crate) fn fov_y(&self) -> f32 {
         (2.0 * (0.5 * self.height as f64 / self.fy as f64).atan()) as f32
     }
 
@@ -95,7 +95,7 @@ impl Camera {
     }
 
     /// World-to-camera transform: the rigid inverse of `camera_to_world` (exact transpose of the rotation).
-    pub fn world_to_camera(&self) -> Mat4 {
+    pub(crate) fn world_to_camera(&self) -> Mat4 {
         let r = Mat3::from_mat4(self.camera_to_world);
         let t = self.camera_to_world.w_axis.truncate();
         let rt = r.transpose();

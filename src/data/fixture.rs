@@ -67,7 +67,7 @@ fn hash(a: u32, b: u32, c: u32) -> u32 {
 }
 
 /// The fixture's joints: even movable parts revolute about a vertical axis, odd ones prismatic.
-pub fn fixture_joints(movable_parts: usize) -> Vec<GtJoint> {
+pub(crate) fn fixture_joints(movable_parts: usize) -> Vec<GtJoint> {
     (0..movable_parts)
         .map(|k| {
             let kf = k as f32;
@@ -300,7 +300,7 @@ pub fn write_npy_i64(h: usize, w: usize, data: &[i64]) -> Vec<u8> {
 }
 
 /// A PARIS-style `trans.json` whose `trans_info` is one joint object rather than a list.
-pub fn paris_trans_json(joint: &GtJoint) -> Vec<u8> {
+pub(crate) fn paris_trans_json(joint: &GtJoint) -> Vec<u8> {
     gt::write_trans_single(joint)
 }
 

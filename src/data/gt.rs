@@ -25,7 +25,7 @@ pub enum JointKind {
 
 impl JointKind {
     /// The `type` string (and motion key) used in `trans.json`.
-    pub fn trans_name(self) -> &'static str {
+    pub(crate) fn trans_name(self) -> &'static str {
         match self {
             JointKind::Revolute => "rotate",
             JointKind::Prismatic => "translate",

@@ -75,7 +75,7 @@ impl PartMap {
     }
 
     /// Largest id in the map (-1 when all background), `None` when empty.
-    pub fn max_id(&self) -> Option<i16> {
+    pub(crate) fn max_id(&self) -> Option<i16> {
         self.ids.iter().copied().max()
     }
 }

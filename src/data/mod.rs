@@ -87,7 +87,7 @@ impl State {
     }
 
     /// Default frame `time` for this state when the file gives none.
-    pub fn default_time(self) -> f32 {
+    pub(crate) fn default_time(self) -> f32 {
         match self {
             State::Start => 0.0,
             State::End => 1.0,
@@ -133,9 +133,9 @@ impl std::fmt::Display for Split {
 }
 
 /// Name of the transforms file for a split and state, e.g. `transforms_train_start.json`.
-pub fn transforms_file_name(split: Split, state: State) -> String {
+pub(crate) fn transforms_file_name(split: Split, state: State) -> String {
     format!("transforms_{}_{}.json", split.name(), state.name())
 }
 
 /// Path of the ground-truth joints file.
-pub const GT_TRANS_PATH: &str = "gt/trans.json";
+pub(crate) const GT_TRANS_PATH: &str = "gt/trans.json";

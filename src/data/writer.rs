@@ -62,7 +62,7 @@ impl DatasetWriter {
     /// Checks `frame` against the frames already added to its view set (unique plain name; same image size
     /// as the first frame and as its intrinsics; depth and part maps present for all frames or none, of
     /// matching size; part ids ≥ −1) and returns its encoded images (RGBA, depth and semantic maps).
-    pub fn add_frame(
+    pub(crate) fn add_frame(
         &mut self,
         state: State,
         split: Split,

@@ -16,10 +16,10 @@ use crate::mesh::spatial::KdTree;
 pub use crate::object::sampling::sample_surface;
 
 /// Surface samples per mesh in the paper's protocol.
-pub const DEFAULT_SAMPLES: usize = 10_000;
+pub(crate) const DEFAULT_SAMPLES: usize = 10_000;
 
 /// Default sampling seed (any fixed value; fixed so that reruns give the same numbers).
-pub const DEFAULT_SEED: u64 = 0x00a7_3e54_c4a3_f3d1;
+pub(crate) const DEFAULT_SEED: u64 = 0x00a7_3e54_c4a3_f3d1;
 
 /// Sampling settings of the Chamfer distance.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

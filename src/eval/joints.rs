@@ -11,14 +11,14 @@ use crate::data::{GtJoint, JointKind};
 
 /// Below this `sin θ` two unit axis directions count as parallel for the line distance; the skew-line formula
 /// divides by `sin θ` and loses all precision there (ArtGS uses the same cut-off).
-pub const PARALLEL_SIN_EPS: f64 = 1e-6;
+pub(crate) const PARALLEL_SIN_EPS: f64 = 1e-6;
 
 /// Axis Pos is reported in units of 0.1 m, as in the paper's tables.
-pub const AXIS_POS_UNITS_PER_METRE: f64 = 10.0;
+pub(crate) const AXIS_POS_UNITS_PER_METRE: f64 = 10.0;
 
 /// [`Solver::Auto`] matches by brute force while both sides have at most this many joints (8! = 40 320
 /// assignments); beyond it the Hungarian algorithm gives the same optimum in polynomial time.
-pub const BRUTE_FORCE_MAX_JOINTS: usize = 8;
+pub(crate) const BRUTE_FORCE_MAX_JOINTS: usize = 8;
 
 fn dvec(v: glam::Vec3) -> DVec3 {
     DVec3::new(f64::from(v.x), f64::from(v.y), f64::from(v.z))
@@ -48,7 +48,7 @@ pub enum JointFault {
 }
 
 /// Checks that a joint can be evaluated: finite values and a non-zero direction.
-pub fn validate_joint(joint: &GtJoint) -> Result<(), JointFault> {
+pub(crate) fn validate_joint(joint: &GtJoint) -> Result<(), JointFault> {
     if !joint.origin.is_finite() {
         return Err(JointFault::Origin(joint.origin));
     }
@@ -121,7 +121,7 @@ fn joint_translation(joint: &GtJoint) -> DVec3 {
 }
 
 /// Geodesic angle (°) between two rotations, in [0°, 180°].
-pub fn rotation_geodesic_deg(a: DQuat, b: DQuat) -> f64 {
+pub(crate) fn rotation_geodesic_deg(a: DQuat, b: DQuat) -> f64 {
     // For unit quaternions the chord min(|a − b|, |a + b|) = 2·sin(θ/4): exactly 0 for equal rotations (a
     // product a⁻¹·b leaves rounding residue) and well conditioned near 0, unlike acos of the dot product.
     let (a, b) = (a.normalize(), b.normalize());

@@ -59,7 +59,7 @@ pub struct ReconstructionReport {
 }
 
 /// Quality of one part mesh, against `gt` when given.
-pub fn part_quality(
+pub(crate) fn part_quality(
     part: usize,
     mesh: &TriMesh,
     gt: Option<&TriMesh>,
@@ -91,7 +91,7 @@ pub fn part_quality(
 }
 
 /// Quality of one state's reconstruction.
-pub fn state_quality(
+pub(crate) fn state_quality(
     state: &StateReconstruction,
     gt: Option<&GtMeshes>,
     options: &ChamferOptions,

@@ -9,7 +9,7 @@ use crate::data::{DataError, FileSet};
 
 /// Why `path` may not be stored in an archive (`None` when it may): relative, `/`-separated, no
 /// empty, `.` or `..` components, no backslashes, drive letters or control characters.
-pub fn unsafe_path(path: &str) -> Option<&'static str> {
+pub(crate) fn unsafe_path(path: &str) -> Option<&'static str> {
     if path.is_empty() {
         return Some("the path is empty");
     }

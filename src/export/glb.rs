@@ -26,7 +26,7 @@ use crate::data::{DataError, PngPixels, RgbaImage, encode_png};
 use crate::object::{ArticulatedObject, JointKind, Material, RenderMesh};
 
 /// Length of the start → end animation (s).
-pub const ANIMATION_SECONDS: f32 = 2.0;
+pub(crate) const ANIMATION_SECONDS: f32 = 2.0;
 /// Largest rotation between two keyframes (rad).
 const MAX_KEYFRAME_STEP: f32 = std::f32::consts::PI / 6.0;
 

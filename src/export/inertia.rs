@@ -8,9 +8,9 @@ use glam::{DMat3, DVec3, Vec3};
 use crate::articulation::sums::outer;
 
 /// Density (kg/m³) the exports assume: light wood.
-pub const DENSITY: f64 = 500.0;
+pub(crate) const DENSITY: f64 = 500.0;
 /// Wall thickness (m) of the thin-shell model used for open meshes.
-pub const SHELL_THICKNESS: f64 = 0.005;
+pub(crate) const SHELL_THICKNESS: f64 = 0.005;
 
 /// Smallest |volume| / area^(3/2) for which a closed mesh counts as a solid. A sphere has ≈0.094,
 /// a 1 m × 1 m × 1 mm slab ≈3.5e-4, so this only rejects flat or numerically empty closed
@@ -20,7 +20,7 @@ const MIN_VOLUME_RATIO: f64 = 1e-6;
 /// How [`MassProperties`] distributes the mass.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
-pub enum InertiaModel {
+pub(crate) enum InertiaModel {
     /// Uniform solid filling the closed surface.
     Solid,
     /// Uniform wall of [`SHELL_THICKNESS`] over the surface (open or volume-less meshes).
@@ -29,7 +29,7 @@ pub enum InertiaModel {
 
 /// Mass, centre of mass and inertia tensor of a mesh, in the mesh frame and SI units.
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct MassProperties {
+pub(crate) struct MassProperties {
     /// Mass (kg), always positive.
     pub mass: f64,
     /// Centre of mass (m), mesh frame.
@@ -50,7 +50,7 @@ pub struct MassProperties {
 /// Triangles with out-of-range indices or non-finite vertices are skipped; vertices at
 /// bit-identical positions are treated as one, so unindexed (STL-style) meshes can be closed. The
 /// tensor gets a small isotropic floor when needed to be physically valid (see `floor_inertia`).
-pub fn mass_properties(
+pub(crate) fn mass_properties(
     positions: &[Vec3],
     triangles: &[[u32; 3]],
     density: f64,

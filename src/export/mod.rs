@@ -52,7 +52,7 @@ pub struct TwinFiles {
 
 impl TwinFiles {
     /// The files as a fit folder holds them ([`URDF_FILE`] and its meshes, [`GLB_FILE`], [`ZIP_FILE`]).
-    pub fn into_fit_folder(self) -> FileSet {
+    pub(crate) fn into_fit_folder(self) -> FileSet {
         let folder = URDF_FILE.rsplit_once('/').map_or("", |(f, _)| f);
         let mut files: FileSet = self
             .urdf

@@ -22,11 +22,11 @@ use crate::object::{
 };
 
 /// Name of the root link (part 0).
-pub const BASE_LINK: &str = "base";
+pub(crate) const BASE_LINK: &str = "base";
 /// Effort limit written on every joint (N·m or N): URDF requires one, and simulators cap motors by it.
-pub const JOINT_EFFORT: f32 = 50.0;
+pub(crate) const JOINT_EFFORT: f32 = 50.0;
 /// Velocity limit written on every joint (rad/s or m/s).
-pub const JOINT_VELOCITY: f32 = 1.0;
+pub(crate) const JOINT_VELOCITY: f32 = 1.0;
 
 /// Link name of movable part `k` (1 ..= K).
 pub fn part_link(k: usize) -> String {
@@ -227,7 +227,7 @@ fn render_mesh(part: &TwinPart, origin: Vec3) -> RenderMesh {
 }
 
 /// sRGB-encoded value → linear (the images store sRGB; glTF vertex colours are linear).
-pub fn srgb_to_linear(v: f32) -> f32 {
+pub(crate) fn srgb_to_linear(v: f32) -> f32 {
     let v = if v.is_finite() {
         v.clamp(0.0, 1.0)
     } else {

@@ -420,7 +420,7 @@ fn shown_color(mesh: &RenderMesh) -> [f32; 4] {
 }
 
 /// `name` made safe as a file or folder name: letters, digits, `_` and `-` kept, anything else `_`.
-pub fn file_stem(name: &str) -> String {
+pub(crate) fn file_stem(name: &str) -> String {
     UniqueNames::default().file_stem(name)
 }
 

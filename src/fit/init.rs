@@ -150,11 +150,11 @@ fn thin(samples: &[Sample], cell: f32) -> Vec<Sample> {
 #[error(
     "no frame has foreground pixels with valid depth: the reconstruction starts from the depth maps"
 )]
-pub struct NoDepthSamples;
+pub(crate) struct NoDepthSamples;
 
 /// The initial mesh field of one state (see the module docs). Errors when no frame has a usable
 /// depth map.
-pub fn initial_field(
+pub(crate) fn initial_field(
     frames: &[Frame],
     num_parts: usize,
     options: &InitOptions,

@@ -97,7 +97,7 @@ pub enum Command {
 }
 
 /// How often a paused fit asks whether to go on.
-pub const PAUSE_POLL_MS: u32 = 100;
+pub(crate) const PAUSE_POLL_MS: u32 = 100;
 
 /// A render of one training view beside its ground truth, both RGB8 row-major.
 #[derive(Debug, Clone, PartialEq)]

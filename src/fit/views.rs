@@ -25,7 +25,7 @@ impl ViewCycle {
     }
 
     /// Starts a new cycle at the next call.
-    pub fn restart(&mut self) {
+    pub(crate) fn restart(&mut self) {
         self.order.clear();
     }
 }

@@ -18,7 +18,7 @@ const STORAGE: wgpu::BufferUsages = wgpu::BufferUsages::STORAGE
 
 impl GpuContext {
     /// Fails with a readable error when `bytes` cannot be bound as one storage buffer.
-    pub fn check_binding(&self, what: &str, bytes: u64) -> GpuResult<()> {
+    pub(crate) fn check_binding(&self, what: &str, bytes: u64) -> GpuResult<()> {
         let limit = self
             .limits
             .max_storage_buffer_binding_size
@@ -62,7 +62,7 @@ impl GpuContext {
     }
 
     /// A uniform buffer initialised with `value`, writable later with `queue.write_buffer`.
-    pub fn uniform_buffer<T: Pod>(&self, label: &str, value: &T) -> wgpu::Buffer {
+    pub(crate) fn uniform_buffer<T: Pod>(&self, label: &str, value: &T) -> wgpu::Buffer {
         self.device
             .create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some(label),
@@ -75,7 +75,7 @@ impl GpuContext {
     ///
     /// Natively this blocks in `device.poll`; in the browser it awaits the map callback, which
     /// the event loop delivers. Device errors recorded meanwhile are returned instead of data.
-    pub async fn read_buffer<T: Pod>(
+    pub(crate) async fn read_buffer<T: Pod>(
         &self,
         buffer: &wgpu::Buffer,
         len: usize,

@@ -18,7 +18,7 @@ const WORKGROUPS: u32 = 1024;
 /// Scalar FMAs per invocation per loop iteration (2 vec4 chains × 4 unrolled steps).
 const FMAS_PER_ITERATION: u64 = 32;
 /// A timed dispatch should last at least this long.
-pub const TARGET_SECONDS: f64 = 0.05;
+pub(crate) const TARGET_SECONDS: f64 = 0.05;
 /// Timed runs whose median is reported.
 pub const RUNS: usize = 5;
 const MAX_ITERATIONS: u32 = 1 << 20;

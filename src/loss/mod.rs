@@ -35,11 +35,11 @@ const SUMS_STRIDE: u32 = 8;
 /// Floats in the terms buffer.
 const TERMS_LEN: usize = 8;
 /// Gaussian window of SSIM: 11 taps, σ = 1.5 (as in 3DGS and the original SSIM).
-pub const SSIM_WINDOW: usize = 11;
-pub const SSIM_SIGMA: f64 = 1.5;
+pub(crate) const SSIM_WINDOW: usize = 11;
+pub(crate) const SSIM_SIGMA: f64 = 1.5;
 /// SSIM stabilisers (K1 = 0.01, K2 = 0.03, dynamic range 1).
-pub const SSIM_C1: f64 = 0.01 * 0.01;
-pub const SSIM_C2: f64 = 0.03 * 0.03;
+pub(crate) const SSIM_C1: f64 = 0.01 * 0.01;
+pub(crate) const SSIM_C2: f64 = 0.03 * 0.03;
 
 /// Weights of the loss terms.
 ///
@@ -120,7 +120,7 @@ struct LossParams {
 const _: () = assert!(size_of::<LossParams>() == 128);
 
 /// The normalised 1-D Gaussian taps of the SSIM window (the 2-D window is their outer product).
-pub fn ssim_taps() -> [f64; SSIM_WINDOW] {
+pub(crate) fn ssim_taps() -> [f64; SSIM_WINDOW] {
     let r = (SSIM_WINDOW / 2) as f64;
     let mut taps = [0.0; SSIM_WINDOW];
     for (i, t) in taps.iter_mut().enumerate() {

@@ -26,7 +26,7 @@ const MAX_DEPTH: usize = 64;
 /// weight `1.0` (the others `0.0`) in a vertex region. Degenerate triangles (collinear or
 /// coincident corners) are handled as their three edges, so the result is never NaN for finite
 /// input.
-pub fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, Vec3) {
+pub(crate) fn closest_point_on_triangle(p: Vec3, a: Vec3, b: Vec3, c: Vec3) -> (Vec3, Vec3) {
     let ab = b - a;
     let ac = c - a;
     let n = ab.cross(ac);
@@ -100,7 +100,7 @@ fn closest_on_segment(p: Vec3, u: Vec3, v: Vec3) -> (Vec3, f32) {
 
 /// The answer of [`TriangleBvh::closest`].
 #[derive(Debug, Clone, Copy, PartialEq)]
-pub struct ClosestPoint {
+pub(crate) struct ClosestPoint {
     /// Index into the `faces` slice the tree was built from.
     pub face: u32,
     /// The closest surface point.
@@ -113,7 +113,7 @@ pub struct ClosestPoint {
 
 /// A bounding-volume hierarchy over a triangle set for nearest-surface-point queries.
 #[derive(Debug, Clone, Default)]
-pub struct TriangleBvh {
+pub(crate) struct TriangleBvh {
     /// Depth-first order: an inner node's left child follows it directly.
     nodes: Vec<Node>,
     /// Triangle corners in leaf order, so a leaf reads one contiguous run.
@@ -167,7 +167,8 @@ impl TriangleBvh {
         }
     }
 
-    /// Number of triangles in the tree.
+    /// Number of triangles in the tree (the tests check it).
+    #[cfg(test)]
     pub fn len(&self) -> usize {
         self.triangles.len()
     }

@@ -55,7 +55,7 @@ impl KdTree {
 
     /// The input index of the point nearest to `q` and its squared distance; `None` for an
     /// empty tree.
-    pub fn nearest_index(&self, q: Vec3) -> Option<(usize, f64)> {
+    pub(crate) fn nearest_index(&self, q: Vec3) -> Option<(usize, f64)> {
         self.nearest_slot(q)
             .map(|(i, d2)| (self.input[i] as usize, d2))
     }

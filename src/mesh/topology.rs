@@ -43,13 +43,13 @@ pub fn cross_part_faces(faces: &[[u32; 3]], parts: &[u32]) -> usize {
 
 /// The part a face belongs to: the label two or three of its vertices share, else its first
 /// vertex's (only cross-part faces of a global remesh need the fallback).
-pub fn face_part(face: &[u32; 3], parts: &[u32]) -> u32 {
+pub(crate) fn face_part(face: &[u32; 3], parts: &[u32]) -> u32 {
     let [a, b, c] = face.map(|v| parts[v as usize]);
     if b == c { b } else { a }
 }
 
 /// Area-weighted vertex normals (zero for vertices no face uses).
-pub fn vertex_normals(positions: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
+pub(crate) fn vertex_normals(positions: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
     let mut normals = vec![Vec3::ZERO; positions.len()];
     for f in faces {
         let [a, b, c] = f.map(|v| positions[v as usize]);
@@ -63,7 +63,7 @@ pub fn vertex_normals(positions: &[Vec3], faces: &[[u32; 3]]) -> Vec<Vec3> {
 
 /// Keeps the faces with `keep[f]` and the vertices they use, in order. Returns the new field and
 /// the new → old vertex map.
-pub fn retain_faces(field: &MeshField, keep: &[bool]) -> (MeshField, Vec<u32>) {
+pub(crate) fn retain_faces(field: &MeshField, keep: &[bool]) -> (MeshField, Vec<u32>) {
     let faces: Vec<[u32; 3]> = field
         .faces
         .iter()
@@ -75,7 +75,7 @@ pub fn retain_faces(field: &MeshField, keep: &[bool]) -> (MeshField, Vec<u32>) {
 }
 
 /// `field` with `faces` as its faces and only the vertices they use.
-pub fn compact(field: &MeshField, faces: Vec<[u32; 3]>) -> (MeshField, Vec<u32>) {
+pub(crate) fn compact(field: &MeshField, faces: Vec<[u32; 3]>) -> (MeshField, Vec<u32>) {
     let mut new_of = vec![u32::MAX; field.num_vertices()];
     let mut map = Vec::new();
     for f in &faces {
@@ -94,7 +94,7 @@ pub fn compact(field: &MeshField, faces: Vec<[u32; 3]>) -> (MeshField, Vec<u32>)
 }
 
 /// A field whose vertex i is `field`'s vertex `map[i]`, with the given faces.
-pub fn gather_vertices(field: &MeshField, map: &[u32], faces: Vec<[u32; 3]>) -> MeshField {
+pub(crate) fn gather_vertices(field: &MeshField, map: &[u32], faces: Vec<[u32; 3]>) -> MeshField {
     let p = field.num_parts;
     let mut out = MeshField::new(Vec::with_capacity(map.len()), faces, p, 0.0);
     for &v in map {
@@ -113,7 +113,7 @@ pub fn gather_vertices(field: &MeshField, map: &[u32], faces: Vec<[u32; 3]>) -> 
 /// of a split edge; a neighbour that is not split keeps its edge, so the result may have
 /// T-junctions there (the rasterizer does not mind, and the remeshing rebuilds connectivity).
 /// Midpoints take the mean of their edge's attributes; in the returned map they are [`FRESH`].
-pub fn split_faces(field: &MeshField, selected: &[bool]) -> (MeshField, Vec<u32>) {
+pub(crate) fn split_faces(field: &MeshField, selected: &[bool]) -> (MeshField, Vec<u32>) {
     let mut out = field.clone();
     let mut map: Vec<u32> = (0..field.num_vertices() as u32).collect();
     let mut midpoint: HashMap<(u32, u32), u32> = HashMap::new();
@@ -223,7 +223,7 @@ pub fn face_components(faces: &[[u32; 3]]) -> (Vec<u32>, usize) {
 
 /// Keeps, per component, the faces of components holding at least `min_fraction` of the
 /// largest one's faces: the remeshing's small floaters go, real pieces stay.
-pub fn drop_small_components(faces: &[[u32; 3]], min_fraction: f32) -> Vec<bool> {
+pub(crate) fn drop_small_components(faces: &[[u32; 3]], min_fraction: f32) -> Vec<bool> {
     let (component, count) = face_components(faces);
     let mut size = vec![0usize; count];
     for &c in &component {
@@ -239,7 +239,7 @@ pub fn drop_small_components(faces: &[[u32; 3]], min_fraction: f32) -> Vec<bool>
 
 /// Indices grouped by equal key, groups in order of their key's first appearance (so results do
 /// not depend on hash order). The voxel grids of the seeding and the thinning use it.
-pub fn groups_in_order<K: std::hash::Hash + Eq>(
+pub(crate) fn groups_in_order<K: std::hash::Hash + Eq>(
     keys: impl IntoIterator<Item = K>,
 ) -> Vec<Vec<u32>> {
     let mut slot: HashMap<K, usize> = HashMap::new();
@@ -255,13 +255,13 @@ pub fn groups_in_order<K: std::hash::Hash + Eq>(
 }
 
 /// Length of a face's longest edge.
-pub fn longest_edge(positions: &[Vec3], face: &[u32; 3]) -> f32 {
+pub(crate) fn longest_edge(positions: &[Vec3], face: &[u32; 3]) -> f32 {
     let [a, b, c] = face.map(|v| positions[v as usize]);
     a.distance(b).max(b.distance(c)).max(c.distance(a))
 }
 
 /// Median edge length of `faces`.
-pub fn median_edge(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
+pub(crate) fn median_edge(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
     let mut lengths: Vec<f32> = faces
         .iter()
         .flat_map(|f| (0..3).map(move |i| (f[i], f[(i + 1) % 3])))
@@ -280,7 +280,7 @@ pub fn median_edge(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
 /// opacity and part logits (one soup vertex's colour is noisy; their mean is the surface's), and
 /// the mean of the voxel's `normals` (a smoothed normal for the tangent planes). Returns the thinned
 /// field (no faces) and its normals.
-pub fn thin_vertices(
+pub(crate) fn thin_vertices(
     field: &MeshField,
     normals: &[Vec3],
     parts: &[u32],

@@ -47,7 +47,7 @@ pub(crate) use primitives::BOX_FACES;
 pub use primitives::{box_mesh, cylinder_mesh, sphere_mesh};
 
 /// Sampling range (radians) for continuous joints, which have no limits: one full turn centred on the rest pose.
-pub const CONTINUOUS_RANGE: (f32, f32) = (-std::f32::consts::PI, std::f32::consts::PI);
+pub(crate) const CONTINUOUS_RANGE: (f32, f32) = (-std::f32::consts::PI, std::f32::consts::PI);
 
 /// Colour and optional base-colour texture of a surface.
 #[derive(Debug, Clone, PartialEq)]
@@ -129,7 +129,9 @@ impl RenderMesh {
 }
 
 /// Axis-aligned bounds of the finite vertices of `meshes`; `None` when there are none.
-pub fn mesh_bounds<'a>(meshes: impl IntoIterator<Item = &'a RenderMesh>) -> Option<(Vec3, Vec3)> {
+pub(crate) fn mesh_bounds<'a>(
+    meshes: impl IntoIterator<Item = &'a RenderMesh>,
+) -> Option<(Vec3, Vec3)> {
     meshes
         .into_iter()
         .flat_map(|m| m.positions.iter())
@@ -190,7 +192,7 @@ impl Visual {
     /// Triangle meshes of this element in the link frame: primitives tessellated, mesh files scaled, all moved
     /// by `origin`. Material: the URDF material for primitives and for mesh groups that carry none of their own
     /// (STL, OBJ without MTL), else the mesh's own; [`Material::default`] when neither exists.
-    pub fn link_frame_meshes(&self) -> Vec<RenderMesh> {
+    pub(crate) fn link_frame_meshes(&self) -> Vec<RenderMesh> {
         let urdf_material = self.material.clone().unwrap_or_default();
         match &self.geometry {
             Geometry::Box { size } => {
@@ -313,7 +315,7 @@ impl Joint {
     }
 
     /// The rest value: 0 clamped into [`Joint::range`] (0 for fixed joints).
-    pub fn rest_value(&self) -> f32 {
+    pub(crate) fn rest_value(&self) -> f32 {
         self.range()
             .map_or(0.0, |(lo, hi)| 0.0f32.clamp(lo, hi.max(lo)))
     }
@@ -384,7 +386,7 @@ impl ArticulatedObject {
 
     /// Joint indices, parents before children (breadth-first from the root); joints not reachable from
     /// the root are left out.
-    pub fn joint_order(&self) -> Vec<usize> {
+    pub(crate) fn joint_order(&self) -> Vec<usize> {
         kinematics::joint_order(self).0
     }
 

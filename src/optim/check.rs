@@ -10,7 +10,7 @@ use crate::rng::Rng;
 
 /// CPU Adam of one group, the formula of `adam.wgsl` in f64.
 #[derive(Debug, Clone)]
-pub struct CpuAdam {
+pub(crate) struct CpuAdam {
     pub params: Vec<f64>,
     pub m: Vec<f64>,
     pub v: Vec<f64>,

@@ -12,7 +12,7 @@ use bytemuck::{Pod, Zeroable};
 use crate::gpu::{Binding, GpuContext, GpuError, GpuResult, KernelFamily, compute_pass};
 
 /// Marks a fresh element (zero moments) in a remap table.
-pub const FRESH: u32 = u32::MAX;
+pub(crate) const FRESH: u32 = u32::MAX;
 const WG_SIZE: u32 = 256;
 
 /// Hyper-parameters of one group.
@@ -335,7 +335,7 @@ impl Adam {
 
 impl AdamGroup {
     /// Sets the learning rate used from the next step on (e.g. from an [`ExponentialDecay`]).
-    pub fn set_lr(&mut self, lr: f32) {
+    pub(crate) fn set_lr(&mut self, lr: f32) {
         self.config.lr = lr;
     }
 
@@ -345,7 +345,7 @@ impl AdamGroup {
     }
 
     /// Steps taken since creation or the last [`AdamGroup::reset`].
-    pub fn step_count(&self) -> u32 {
+    pub(crate) fn step_count(&self) -> u32 {
         self.step
     }
 
@@ -370,7 +370,7 @@ impl AdamGroup {
     }
 
     /// First and second moments (`len` floats each).
-    pub fn moments(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
+    pub(crate) fn moments(&self) -> (&wgpu::Buffer, &wgpu::Buffer) {
         (&self.m, &self.v)
     }
 

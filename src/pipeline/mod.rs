@@ -15,7 +15,7 @@ use crate::fit::observer::Observer;
 use crate::gpu::{GpuContext, GpuError, now_seconds};
 
 /// The category label of a user's dataset (the demo's objects carry their synthetic category).
-pub const UNKNOWN_CATEGORY: &str = "unknown";
+pub(crate) const UNKNOWN_CATEGORY: &str = "unknown";
 
 /// Why the pipeline stopped, phrased for the person who ran it.
 #[derive(Debug)]

@@ -92,7 +92,7 @@ impl MeshField {
     }
 
     /// Sets vertex `v`'s view-independent colour (degree-0 SH), higher bands zeroed.
-    pub fn set_color(&mut self, v: usize, rgb: Vec3) {
+    pub(crate) fn set_color(&mut self, v: usize, rgb: Vec3) {
         let c = &mut self.sh[v * SH_FLOATS..(v + 1) * SH_FLOATS];
         c.fill(0.0);
         for (k, value) in rgb.to_array().into_iter().enumerate() {
@@ -102,7 +102,7 @@ impl MeshField {
 
     /// Vertex `v`'s view-independent colour (the degree-0 SH term, as [`MeshField::set_color`] sets it),
     /// in the images' encoding, unclamped.
-    pub fn dc_color(&self, v: usize) -> Vec3 {
+    pub(crate) fn dc_color(&self, v: usize) -> Vec3 {
         let sh = &self.sh[v * SH_FLOATS..v * SH_FLOATS + 3];
         Vec3::new(sh[0], sh[1], sh[2]) * SH_C0 + 0.5
     }
@@ -251,7 +251,7 @@ impl GpuField {
     }
 
     /// Reads the gradients of the last backward pass.
-    pub async fn read_gradients(&self, ctx: &GpuContext) -> GpuResult<FieldGradients> {
+    pub(crate) async fn read_gradients(&self, ctx: &GpuContext) -> GpuResult<FieldGradients> {
         let n = self.num_vertices as usize;
         let positions: Vec<[f32; 4]> = ctx.read_buffer(&self.grad_positions, n).await?;
         Ok(FieldGradients {

@@ -15,18 +15,18 @@ pub const TILE: u32 = 8;
 /// Most part logits per vertex (K + 1 with K = 15 movable parts).
 pub const MAX_PARTS: usize = 16;
 /// Floats per (face, tile) pair gradient, without part logits (`PAIR_GRADS` in WGSL).
-pub const PAIR_GRADS: u64 = 25;
+pub(crate) const PAIR_GRADS: u64 = 25;
 /// Floats per corner gradient before its part logits (`CORNER_GRADS` in WGSL).
-pub const CORNER_GRADS: u64 = 8;
+pub(crate) const CORNER_GRADS: u64 = 8;
 /// SH coefficients per colour channel (degree 3).
-pub const SH_COEFFS: usize = 16;
+pub(crate) const SH_COEFFS: usize = 16;
 /// ln of the depth range the sort keys quantise (1 mm .. 1 km), as in WGSL.
-pub const LOG_DEPTH_RANGE: (f32, f32) = (-6.907_755, 6.907_755);
+pub(crate) const LOG_DEPTH_RANGE: (f32, f32) = (-6.907_755, 6.907_755);
 
 /// Uniform block of every rasterizer kernel (`RasterParams` in WGSL).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct RasterParams {
+pub(crate) struct RasterParams {
     pub world_to_camera: [[f32; 4]; 4],
     pub camera_position: [f32; 4],
     pub focal: [f32; 4],
@@ -53,10 +53,10 @@ const _: () = assert!(size_of::<RasterParams>() == 176);
 /// One projected face (`FaceRecord` in WGSL); only its size matters on the CPU.
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Pod, Zeroable)]
-pub struct FaceRecord {
+pub(crate) struct FaceRecord {
     pub words: [[f32; 4]; 9],
 }
-pub const FACE_RECORD_BYTES: u64 = size_of::<FaceRecord>() as u64;
+pub(crate) const FACE_RECORD_BYTES: u64 = size_of::<FaceRecord>() as u64;
 const _: () = assert!(FACE_RECORD_BYTES == 144);
 
 /// A kernel family compiled with the rasterizer's shared structs prepended.
@@ -79,7 +79,7 @@ fn family<const N: usize>(
 use Binding::{StorageRead as R, StorageReadWrite as RW, Uniform as U};
 
 /// `shaders/sh.wgsl`: view-dependent vertex colours and their backward pass.
-pub struct ShKernels {
+pub(crate) struct ShKernels {
     pub family: KernelFamily,
     pub vertex_colors: wgpu::ComputePipeline,
     pub backward: wgpu::ComputePipeline,
@@ -103,7 +103,7 @@ impl ShKernels {
 }
 
 /// A family with a single entry point.
-pub struct Kernel {
+pub(crate) struct Kernel {
     family: KernelFamily,
     pipeline: wgpu::ComputePipeline,
     label: &'static str,
@@ -182,7 +182,7 @@ impl Kernel {
     }
 
     /// `shaders/raster_face_grad.wgsl`: pair gradients → corner gradients.
-    pub fn face_gradients(ctx: &GpuContext) -> Self {
+    pub(crate) fn face_gradients(ctx: &GpuContext) -> Self {
         Self::new(
             ctx,
             "raster_face_grad",
@@ -193,7 +193,7 @@ impl Kernel {
     }
 
     /// `shaders/raster_vertex_grad.wgsl`: corner gradients → vertex gradients.
-    pub fn vertex_gradients(ctx: &GpuContext) -> Self {
+    pub(crate) fn vertex_gradients(ctx: &GpuContext) -> Self {
         Self::new(
             ctx,
             "raster_vertex_grad",
@@ -205,7 +205,7 @@ impl Kernel {
 }
 
 /// `shaders/raster_bin.wgsl`: pair emission and tile ranges after the sort.
-pub struct BinKernels {
+pub(crate) struct BinKernels {
     pub family: KernelFamily,
     pub emit_pairs: wgpu::ComputePipeline,
     pub tile_ranges: wgpu::ComputePipeline,

@@ -30,7 +30,7 @@ const C3: [f64; 7] = [
 ];
 
 /// Real SH basis Y_0..Y_15 at unit direction `d`, zero beyond `degree`.
-pub fn sh_basis(d: DVec3, degree: u32) -> [f64; 16] {
+pub(crate) fn sh_basis(d: DVec3, degree: u32) -> [f64; 16] {
     let (x, y, z) = (d.x, d.y, d.z);
     let mut b = [0.0; 16];
     b[0] = C0;
@@ -59,7 +59,7 @@ pub fn sh_basis(d: DVec3, degree: u32) -> [f64; 16] {
 }
 
 /// Vertex colour seen from `eye`: max(Σ Y_l c_l + 0.5, 0).
-pub fn vertex_color(field: &MeshField, v: usize, eye: DVec3, degree: u32) -> DVec3 {
+pub(crate) fn vertex_color(field: &MeshField, v: usize, eye: DVec3, degree: u32) -> DVec3 {
     let d = (field.positions[v].as_dvec3() - eye).normalize_or_zero();
     let basis = sh_basis(d, degree.min(3));
     let c = &field.sh[v * SH_FLOATS..(v + 1) * SH_FLOATS];
@@ -98,7 +98,7 @@ pub fn render(field: &MeshField, camera: &Camera, settings: &RasterSettings) -> 
 
 /// [`render`], plus per face its largest blending weight α·T and the number of pixels it
 /// contributed to (what [`super::RasterState::read_face_stats`] returns for one render).
-pub fn render_with_stats(
+pub(crate) fn render_with_stats(
     field: &MeshField,
     camera: &Camera,
     settings: &RasterSettings,

@@ -48,7 +48,7 @@ impl Default for RasterSettings {
 impl RasterSettings {
     /// The same model without the hard cut-offs, so the output is smooth in every parameter
     /// (what finite-difference checks need, as Brush does).
-    pub fn smooth(self) -> Self {
+    pub(crate) fn smooth(self) -> Self {
         Self {
             alpha_min: 0.0,
             transmittance_min: 0.0,

@@ -242,7 +242,7 @@ impl RasterState {
     }
 
     /// Reads the per-face (max blending weight, pixel count) statistics.
-    pub async fn read_face_stats(
+    pub(crate) async fn read_face_stats(
         &self,
         ctx: &GpuContext,
         faces: u32,

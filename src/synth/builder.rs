@@ -55,7 +55,7 @@ pub fn cuboid(centre: Vec3, size: Vec3, material: &Material) -> RenderMesh {
 }
 
 /// Box of full side lengths `size` centred on the origin of `pose`.
-pub fn oriented_cuboid(pose: Affine3A, size: Vec3, material: &Material) -> RenderMesh {
+pub(crate) fn oriented_cuboid(pose: Affine3A, size: Vec3, material: &Material) -> RenderMesh {
     let mut m = empty(material);
     let h = size * 0.5;
     for (n, u, v) in BOX_FACES {
@@ -71,7 +71,7 @@ fn z_to(d: Vec3) -> Quat {
 }
 
 /// Capped truncated cone from `a` (radius `ra`) to `b` (radius `rb`); a cylinder when `ra == rb`.
-pub fn frustum(a: Vec3, b: Vec3, ra: f32, rb: f32, material: &Material) -> RenderMesh {
+pub(crate) fn frustum(a: Vec3, b: Vec3, ra: f32, rb: f32, material: &Material) -> RenderMesh {
     let mut m = empty(material);
     let length = (b - a).length();
     let slope = (ra - rb) / length.max(1e-9);
@@ -118,7 +118,7 @@ pub fn frustum(a: Vec3, b: Vec3, ra: f32, rb: f32, material: &Material) -> Rende
 }
 
 /// Capped cylinder of radius `r` from `a` to `b`.
-pub fn cylinder(a: Vec3, b: Vec3, r: f32, material: &Material) -> RenderMesh {
+pub(crate) fn cylinder(a: Vec3, b: Vec3, r: f32, material: &Material) -> RenderMesh {
     frustum(a, b, r, r, material)
 }
 
@@ -154,7 +154,13 @@ fn grid_triangles(m: &mut RenderMesh, rows: u32, cols: u32) {
 }
 
 /// Torus around `axis` through `centre`: ring radius `major`, tube radius `minor`.
-pub fn torus(centre: Vec3, axis: Vec3, major: f32, minor: f32, material: &Material) -> RenderMesh {
+pub(crate) fn torus(
+    centre: Vec3,
+    axis: Vec3,
+    major: f32,
+    minor: f32,
+    material: &Material,
+) -> RenderMesh {
     let mut m = empty(material);
     let tube = SEGMENTS / 2;
     let uvs = m.uvs.get_or_insert_with(Vec::new);

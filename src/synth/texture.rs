@@ -11,10 +11,10 @@ use crate::object::Material;
 use crate::rng::Rng;
 
 /// Texture side in pixels: fine enough for 800² renders of a tile that covers [`TILE_METRES`].
-pub const TEXTURE_SIZE: u32 = 256;
+pub(crate) const TEXTURE_SIZE: u32 = 256;
 
 /// World size of one texture tile: shape helpers set UV = position / `TILE_METRES`.
-pub const TILE_METRES: f32 = 0.5;
+pub(crate) const TILE_METRES: f32 = 0.5;
 
 /// Kind of surface finish.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -185,7 +185,7 @@ fn palette(finish: Finish) -> &'static [[f32; 3]] {
 
 /// A textured material of `finish` with a colour drawn from the finish's palette (slightly jittered) and a
 /// texture seed drawn from `rng`.
-pub fn random_material(name: &str, finish: Finish, rng: &mut Rng) -> Material {
+pub(crate) fn random_material(name: &str, finish: Finish, rng: &mut Rng) -> Material {
     let base = *rng.pick(palette(finish));
     let jitter = rng.uniform(0.85, 1.15);
     let seed = rng.next_u64();
@@ -193,7 +193,7 @@ pub fn random_material(name: &str, finish: Finish, rng: &mut Rng) -> Material {
 }
 
 /// An untextured material with a colour from `finish`'s palette (for handles, knobs, hinges).
-pub fn random_plain(name: &str, finish: Finish, rng: &mut Rng) -> Material {
+pub(crate) fn random_plain(name: &str, finish: Finish, rng: &mut Rng) -> Material {
     plain(name, *rng.pick(palette(finish)))
 }
 

@@ -133,13 +133,13 @@ impl<'a> CloudPair<'a> {
     /// Mean colour difference (0–1 per channel, mean over RGB) between each point moved by `m`
     /// and its match in the other state, over the kept matches of both directions: what tells
     /// apart motions the shape alone cannot (a knob's pointer mark, a door's two faces).
-    pub fn color_residual(&self, m: &PartMotion) -> f64 {
+    pub(crate) fn color_residual(&self, m: &PartMotion) -> f64 {
         let matches = self.matches(m);
         matches.iter().map(|c| c.color).sum::<f64>() / matches.len().max(1) as f64
     }
 
     /// Trimmed RMS point-to-plane residual (m) of `m`, both directions.
-    pub fn residual(&self, m: &PartMotion) -> f64 {
+    pub(crate) fn residual(&self, m: &PartMotion) -> f64 {
         rms(&self.matches(m), m)
     }
 }

@@ -37,7 +37,7 @@ pub struct Ablation {
 
 impl Ablation {
     /// The full model.
-    pub const FULL: Ablation = Ablation {
+    pub(crate) const FULL: Ablation = Ablation {
         vertex_color: true,
         vertex_opacity: true,
         backward: true,
@@ -165,7 +165,7 @@ pub struct ArticulationConfig {
 
 impl ArticulationConfig {
     /// Renders per refinement step, both directions, for states of `views` training views.
-    pub fn refine_renders(&self, views: usize) -> usize {
+    pub(crate) fn refine_renders(&self, views: usize) -> usize {
         match self.refine_views {
             RefineViews::One => 2,
             RefineViews::All => 2 * views.max(1),
@@ -173,7 +173,7 @@ impl ArticulationConfig {
     }
 
     /// The step at which the joint types are decided: candidates before it, refinement after.
-    pub fn decision_step(&self) -> u32 {
+    pub(crate) fn decision_step(&self) -> u32 {
         ((self.iterations as f32 * self.decide_at) as u32).min(self.iterations)
     }
 

@@ -64,7 +64,7 @@ impl FieldAdam {
     }
 
     /// Sets the position learning rate (the one group with a schedule).
-    pub fn set_position_lr(&mut self, lr: f32) {
+    pub(crate) fn set_position_lr(&mut self, lr: f32) {
         self.groups[0].set_lr(lr);
     }
 

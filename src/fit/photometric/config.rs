@@ -61,7 +61,7 @@ impl Default for PhotometricConfig {
 
 impl PhotometricConfig {
     /// Raster settings at iteration `i`.
-    pub fn settings_at(&self, i: u32) -> RasterSettings {
+    pub(crate) fn settings_at(&self, i: u32) -> RasterSettings {
         let t = i as f32 / self.iterations.max(1) as f32;
         let (g0, g1) = self.gamma;
         let (r0, r1) = self.opacity_ramp;
@@ -90,7 +90,7 @@ pub struct CurvePoint {
 
 impl PhotometricConfig {
     /// The position learning rate's log-linear decay over the run.
-    pub fn position_decay(&self) -> ExponentialDecay {
+    pub(crate) fn position_decay(&self) -> ExponentialDecay {
         ExponentialDecay {
             start: self.position_lr.0,
             end: self.position_lr.1,
@@ -99,7 +99,7 @@ impl PhotometricConfig {
     }
 
     /// The learning rates at the start, with `position` for the scheduled group.
-    pub fn rates(&self, position: f32) -> FieldLearningRates {
+    pub(crate) fn rates(&self, position: f32) -> FieldLearningRates {
         FieldLearningRates {
             position,
             sh: self.sh_lr,

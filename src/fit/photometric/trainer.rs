@@ -123,7 +123,7 @@ impl<'a> Trainer<'a> {
     }
 
     /// Mean PSNR over all views with `settings`.
-    pub async fn mean_psnr(
+    pub(crate) async fn mean_psnr(
         &mut self,
         ctx: &GpuContext,
         settings: &RasterSettings,
@@ -202,7 +202,7 @@ impl<'a> Trainer<'a> {
 
     /// Step `i` of `config`'s schedule: its settings and position rate, one step, and the
     /// curve point when `i` is a reporting iteration. Returns the settings it stepped with.
-    pub async fn scheduled_step(
+    pub(crate) async fn scheduled_step(
         &mut self,
         ctx: &GpuContext,
         config: &PhotometricConfig,
@@ -224,7 +224,7 @@ impl<'a> Trainer<'a> {
     }
 
     /// Per face (max blending weight, pixels covered) since the last clear.
-    pub async fn read_face_stats(&self, ctx: &GpuContext) -> GpuResult<Vec<(f32, u32)>> {
+    pub(crate) async fn read_face_stats(&self, ctx: &GpuContext) -> GpuResult<Vec<(f32, u32)>> {
         self.state.read_face_stats(ctx, self.field.num_faces).await
     }
 
@@ -236,7 +236,7 @@ impl<'a> Trainer<'a> {
     /// Starts a new fit of `field` against the same views: fresh Adam moments at `lr` and a new
     /// view order from `seed`. The rasterizer, the loss and the uploaded targets are kept (the
     /// reconstruction's recovery stage needs no second upload or pipeline build).
-    pub fn restart(
+    pub(crate) fn restart(
         &mut self,
         ctx: &GpuContext,
         field: &MeshField,
@@ -253,7 +253,7 @@ impl<'a> Trainer<'a> {
 
     /// Replaces the field after a topology edit, carrying Adam's moments along `map`
     /// (`map[new vertex] = old vertex` or [`crate::optim::FRESH`]).
-    pub fn replace_field(
+    pub(crate) fn replace_field(
         &mut self,
         ctx: &GpuContext,
         field: &MeshField,

@@ -40,10 +40,10 @@ use crate::gpu::{GpuContext, GpuError, GpuResult};
 /// A state of the dataset without training views, so there is nothing to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("the dataset has no {} training views", .0.name())]
-pub struct NoTrainingViews(pub State);
+pub(crate) struct NoTrainingViews(pub State);
 
 /// The training views of `state` under `config`: evenly spaced, downsampled.
-pub fn training_views(
+pub(crate) fn training_views(
     dataset: &Dataset,
     state: State,
     config: &ReconstructionConfig,

@@ -30,7 +30,7 @@ pub enum MeshFormat {
 
 impl MeshFormat {
     /// Format from a file name's extension (case-insensitive); `None` for anything else.
-    pub fn from_path(path: &str) -> Option<MeshFormat> {
+    pub(crate) fn from_path(path: &str) -> Option<MeshFormat> {
         let name = path.rsplit('/').next().unwrap_or(path);
         let ext = name.rsplit_once('.')?.1.to_ascii_lowercase();
         match ext.as_str() {

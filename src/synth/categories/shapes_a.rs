@@ -24,7 +24,7 @@ fn vertex(m: &mut RenderMesh, p: Vec3, n: Vec3, uv_metres: Vec2) {
 /// `z1`, then moved by `pose`. The caps are fans from the mean of the outline's points, so the outline must be
 /// star-shaped about that point (every convex outline is; blades and jaws are drawn that way). Fewer than three
 /// points or a zero-area outline give an empty mesh.
-pub fn prism(
+pub(crate) fn prism(
     outline: &[Vec2],
     z0: f32,
     z1: f32,
@@ -89,7 +89,13 @@ pub fn prism(
 /// the mean direction at each joint and carried along without twist, so smooth paths (many short segments
 /// at bends) give clean tubes. Repeated points are skipped; a path shorter than two distinct points gives an
 /// empty mesh.
-pub fn tube(path: &[Vec3], r0: f32, r1: f32, segments: u32, material: &Material) -> RenderMesh {
+pub(crate) fn tube(
+    path: &[Vec3],
+    r0: f32,
+    r1: f32,
+    segments: u32,
+    material: &Material,
+) -> RenderMesh {
     let mut m = empty(material);
     let mut pts: Vec<Vec3> = Vec::with_capacity(path.len());
     for &p in path {
@@ -170,7 +176,7 @@ pub fn tube(path: &[Vec3], r0: f32, r1: f32, segments: u32, material: &Material)
 /// Points of a superellipse in the plane spanned by `u` and `v` around `centre`: semi-axes `a` (along u) and
 /// `b` (along v), exponent `power` (2 = ellipse, larger = squarer), `n` points, closed (the first point is
 /// repeated at the end) for [`tube`].
-pub fn superellipse(
+pub(crate) fn superellipse(
     centre: Vec3,
     u: Vec3,
     v: Vec3,
@@ -190,7 +196,7 @@ pub fn superellipse(
 }
 
 /// Quadratic Bézier from `a` to `c` pulled towards `b`, as `n + 1` points (for bent tubes).
-pub fn bezier(a: Vec3, b: Vec3, c: Vec3, n: usize) -> Vec<Vec3> {
+pub(crate) fn bezier(a: Vec3, b: Vec3, c: Vec3, n: usize) -> Vec<Vec3> {
     (0..=n)
         .map(|i| {
             let t = i as f32 / n.max(1) as f32;
@@ -201,7 +207,7 @@ pub fn bezier(a: Vec3, b: Vec3, c: Vec3, n: usize) -> Vec<Vec3> {
 
 /// The rigid motion rotating by `angle` about the line through `pivot` along `axis` (to place parts at a
 /// pose other than the one they are drawn in).
-pub fn rotation_about(pivot: Vec3, axis: Vec3, angle: f32) -> Affine3A {
+pub(crate) fn rotation_about(pivot: Vec3, axis: Vec3, angle: f32) -> Affine3A {
     Affine3A::from_translation(pivot)
         * Affine3A::from_axis_angle(axis.normalize_or(Vec3::Z), angle)
         * Affine3A::from_translation(-pivot)
