@@ -8,7 +8,7 @@ use serde::Deserialize;
 use wasm_bindgen::prelude::*;
 
 use crate::fit::object::FitConfig;
-use crate::fit::preset::{Budget, BudgetOverrides, Preset};
+use crate::fit::preset::{Budget, BudgetOverrides, Preset, UnknownPreset};
 
 /// The page's budget overrides as JSON; a missing or `null` field keeps the preset's number.
 /// Unknown fields are refused so that a misspelt one is not silently ignored.
@@ -40,7 +40,7 @@ impl From<PageOverrides> for BudgetOverrides {
 #[derive(Debug)]
 pub(crate) enum BudgetError {
     /// Not one of the presets' names (the message lists them).
-    Preset(String),
+    Preset(UnknownPreset),
     /// Not a JSON object of known budget fields with non-negative whole numbers.
     Json(serde_json::Error),
     /// A count that must be at least 1 (a fit without steps or faces has nothing to do).
@@ -50,7 +50,7 @@ pub(crate) enum BudgetError {
 impl fmt::Display for BudgetError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            BudgetError::Preset(message) => f.write_str(message),
+            BudgetError::Preset(e) => write!(f, "{e}"),
             BudgetError::Json(e) => write!(f, "budget overrides: {e}"),
             BudgetError::Zero(field) => write!(f, "budget overrides: {field} must be at least 1"),
         }
@@ -61,7 +61,7 @@ impl std::error::Error for BudgetError {}
 
 /// The named preset.
 pub(crate) fn preset(name: &str) -> Result<Preset, BudgetError> {
-    Preset::parse(name).map_err(|e| BudgetError::Preset(e.to_string()))
+    Preset::parse(name).map_err(BudgetError::Preset)
 }
 
 /// Overrides from the page's JSON; none (or blank) changes nothing.

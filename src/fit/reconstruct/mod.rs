@@ -28,9 +28,6 @@ mod state;
 pub use config::{DensifyConfig, ReconstructionConfig, RemeshMode};
 pub use results::{PhaseTimes, Reconstruction, RemeshStats, StateReconstruction};
 pub use state::reconstruct_state;
-// Their old home, for the callers outside fit that still import them from here.
-pub use super::observer::{Phase, Progress};
-pub use super::preset::Preset;
 
 use super::views::downsample_frame;
 use crate::data::{Dataset, Frame, Split, State};
