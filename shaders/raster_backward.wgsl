@@ -1,10 +1,11 @@
-// Backward compositing: one workgroup per 8×8 tile, each invocation replaying 4 pixels of one
-// column in the forward front-to-back order, up to the entries each pixel consumed. With O the
+// Backward compositing: one workgroup per 8×8 tile, each invocation replaying one pixel in the
+// forward front-to-back order over the faces whose coverage mask holds it, up to the entries the
+// pixel consumed. With O the
 // pixel's final output and P_n the accumulation up to and including face n,
 //   dO/dα_n = q_n T_n − (O − P_n) / (1 − α_n),   dO/dq_n = α_n T_n,
 // so no reverse traversal or division by T is needed. A face's gradient (w.r.t. its record's
 // barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part logits) is summed
-// over the invocation's pixels in registers, then over the tile in workgroup memory
+// over the tile's pixels in workgroup memory
 // (compare-exchange on f32 bits: the browser has no float atomics), and written once per
 // (face, tile) pair, at its sorted slot.
 //
@@ -18,8 +19,7 @@
 @group(0) @binding(7) var<storage, read_write> pair_grads: array<f32>;
 @group(0) @binding(8) var<storage, read_write> pair_logit_grads: array<f32>;
 
-const PIXELS: u32 = 4u;                  // pixels per invocation, rows of one column
-const INVOCATIONS: u32 = TILE * TILE / PIXELS;
+const INVOCATIONS: u32 = TILE * TILE;
 var<workgroup> acc: array<atomic<u32>, BATCH * PAIR_GRADS>;
 var<workgroup> acc_logits: array<atomic<u32>, BATCH * 3u * MAX_PARTS>;
 
@@ -111,14 +111,8 @@ fn start_pixel(px: u32, py: u32) -> Pixel {
     return s;
 }
 
-// Replays staged face `b` (list entry `entry`) at pixel `s`, adding its gradient to `fg`.
-fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeometry, b: u32, entry: u32) {
-    if (entry >= (*s).consumed) {
-        (*s).done = true;
-    }
-    if ((*s).done) {
-        return;
-    }
+// Replays staged face `b` at pixel `s`, adding its gradient to `fg`.
+fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeometry, b: u32) {
     let hit = evaluate_face(geom, (*s).p, params.gamma, params.alpha_min);
     if (hit.alpha <= 0.0) {
         return;
@@ -195,28 +189,27 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
     if (tile >= params.tiles_x * params.tiles_y) {
         return;
     }
-    let column = column_pixel(tile, lid, PIXELS);
-    let px = column.x;
-    let py = column.y;
-    var s0 = start_pixel(px, py);
-    var s1 = start_pixel(px, py + 1u);
-    var s2 = start_pixel(px, py + 2u);
-    var s3 = start_pixel(px, py + 3u);
+    let px = tile_pixel(tile, lid);
+    var s = start_pixel(px.x, px.y);
     let r = tile_range(tile, lid);
     let logit_stride = 3u * params.num_parts;
     for (var start = r.x; start < r.y; start += BATCH) {
         stage_batch(start, r.y, lid, INVOCATIONS);
         workgroupBarrier();
         let count = min(BATCH, r.y - start);
-        // Uniform loop (see raster_composite.wgsl).
-        for (var b = 0u; b < count; b++) {
-            let geom = batch[b];
-            let entry = start + b - r.x;
+        var word = covering_faces(lid, count);
+        loop {
+            if (word == 0u || s.done) {
+                break;
+            }
+            let b = firstTrailingBit(word);
+            word &= word - 1u;
+            if (start + b - r.x >= s.consumed) {
+                s.done = true;
+                break;
+            }
             var fg = FaceGrad();
-            backprop(&s0, &fg, geom, b, entry);
-            backprop(&s1, &fg, geom, b, entry);
-            backprop(&s2, &fg, geom, b, entry);
-            backprop(&s3, &fg, geom, b, entry);
+            backprop(&s, &fg, batch[b], b);
             if (fg.hit) {
                 flush(fg, b);
             }

@@ -1,16 +1,17 @@
 // Tile binning. `emit_pairs` (one invocation per face) writes a (tile, depth) sort key for every
-// tile the face touches, at the face's scanned offset; after the radix sort, `tile_ranges` (one
-// invocation per sorted pair) records each tile's [start, end) in the sorted list, the face of
-// every sorted slot, and the sorted slot of every emitted pair (so gradients written per sorted
-// slot can be gathered per face without atomics).
+// tile where the face's coverage mask is not empty, at the face's scanned offset, with the face
+// and its mask; after the radix sort, `tile_ranges` (one invocation per sorted pair) records each
+// tile's [start, end) in the sorted list, the face and mask of every sorted slot, and the sorted
+// slot of every emitted pair (so gradients written per sorted slot can be gathered per face
+// without atomics).
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
 @group(0) @binding(1) var<storage, read> records: array<FaceRecord>;
 @group(0) @binding(2) var<storage, read> offsets: array<u32>;        // exclusive scan of tile counts
 @group(0) @binding(3) var<storage, read_write> keys: array<u32>;     // the sorter's keys
 @group(0) @binding(4) var<storage, read_write> values: array<u32>;   // the sorter's values: emission index
-@group(0) @binding(5) var<storage, read_write> pair_face: array<u32>;   // emission index -> face
-@group(0) @binding(6) var<storage, read_write> sorted_face: array<u32>; // sorted slot -> face
+@group(0) @binding(5) var<storage, read_write> pair_info: array<vec4<u32>>;   // emission index -> face, mask (2 words), 0
+@group(0) @binding(6) var<storage, read_write> sorted_info: array<vec4<u32>>; // sorted slot -> face, mask, 0
 @group(0) @binding(7) var<storage, read_write> pair_slot: array<u32>;   // emission index -> sorted slot
 @group(0) @binding(8) var<storage, read_write> tile_ranges: array<u32>; // 2 per tile: start, end
 
@@ -26,20 +27,39 @@ fn emit_pairs(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     if (f >= params.num_faces) {
         return;
     }
-    let rect = records[f].tiles;
-    if (rect.x > rect.z) {
+    let rec = records[f];
+    let box = rec.pixels;
+    if (box.x > box.z) {
         return;
     }
-    let depth = depth_key(records[f].inv_w.w);
+    let lo = box.xy;
+    let hi = box.zw;
+    let exact = exact_masks(lo, hi);
+    let g = face_geometry(rec);
+    let depth = depth_key(rec.inv_w.w);
+    let t0 = lo / TILE;
+    let t1 = hi / TILE;
     var e = offsets[f];
-    for (var ty = rect.y; ty <= rect.w; ty++) {
-        for (var tx = rect.x; tx <= rect.z; tx++) {
-            let tile = ty * params.tiles_x + tx;
-            keys[e] = (tile << params.depth_bits) | depth;
-            values[e] = e;
-            pair_face[e] = f;
-            e++;
+    let end = offsets[f + 1u];
+    var tile = 0u;
+    for (var ty = t0.y; ty <= t1.y; ty++) {
+        for (var tx = t0.x; tx <= t1.x; tx++) {
+            let m = tile_mask(g, vec2<u32>(tx, ty), lo, hi, exact, params.gamma, params.alpha_min);
+            tile = ty * params.tiles_x + tx;
+            // Never more than `project_faces` counted, whatever the compiler made of the test.
+            if ((m.x | m.y) != 0u && e < end) {
+                keys[e] = (tile << params.depth_bits) | depth;
+                values[e] = e;
+                pair_info[e] = vec4<u32>(f, m, 0u);
+                e++;
+            }
         }
+    }
+    // Fewer found than counted (same caveat): fill with empty masks, which composite nothing.
+    for (; e < end; e++) {
+        keys[e] = (tile << params.depth_bits) | depth;
+        values[e] = e;
+        pair_info[e] = vec4<u32>(f, 0u, 0u, 0u);
     }
 }
 
@@ -55,7 +75,7 @@ fn find_tile_ranges(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         return;
     }
     let e = values[j];
-    sorted_face[j] = pair_face[e];
+    sorted_info[j] = pair_info[e];
     pair_slot[e] = j;
     let tile = tile_of(j);
     if (j == 0u || tile_of(j - 1u) != tile) {

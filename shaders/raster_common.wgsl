@@ -51,7 +51,7 @@ struct FaceRecord {
     color1: vec4<f32>,
     color2: vec4<f32>,
     verts: vec4<u32>,   // vertex indices
-    tiles: vec4<u32>,   // inclusive tile rectangle x0, y0, x1, y1; x0 > x1 when culled
+    pixels: vec4<u32>,  // inclusive box of the pixel centres it may cover, x0, y0, x1, y1; x0 > x1 when culled
 }
 
 // The part of a record the coverage test needs.
@@ -125,4 +125,40 @@ fn evaluate_face(g: FaceGeometry, p: vec2<f32>, gamma: f32, alpha_min: f32) -> H
 
 fn hit_color(rec: FaceRecord, mu: vec3<f32>) -> vec3<f32> {
     return mu.x * rec.color0.xyz + mu.y * rec.color1.xyz + mu.z * rec.color2.xyz;
+}
+
+// Pixel boxes larger than this get conservative coverage masks (every pixel of the box): the
+// exact test costs one face evaluation per pixel of the box, in one invocation.
+const EXACT_MASK_PIXELS: u32 = 1024u;
+
+// Which pixels of `tile` a face reaches: bit (y · TILE + x) of the tile's 64 (x, y local; bits
+// 32.. in the second word) is set where `evaluate_face` gives α > 0, inside the pixel box
+// [lo, hi]; with `exact` false, every pixel of the box. Emission drops pairs whose mask is empty
+// and the compositing kernels evaluate a face only where its bit is set, so this is the test
+// that decides which pixel–face evaluations happen at all.
+fn tile_mask(g: FaceGeometry, tile: vec2<u32>, lo: vec2<u32>, hi: vec2<u32>, exact: bool, gamma: f32, alpha_min: f32) -> vec2<u32> {
+    let t0 = tile * TILE;
+    let a = max(lo, t0);
+    let b = min(hi, t0 + vec2<u32>(TILE - 1u));
+    var m = vec2<u32>(0u, 0u);
+    for (var y = a.y; y <= b.y; y++) {
+        for (var x = a.x; x <= b.x; x++) {
+            let p = vec2<f32>(f32(x) + 0.5, f32(y) + 0.5);
+            if (!exact || evaluate_face(g, p, gamma, alpha_min).alpha > 0.0) {
+                let bit = (y - t0.y) * TILE + (x - t0.x);
+                if (bit < 32u) {
+                    m.x |= 1u << bit;
+                } else {
+                    m.y |= 1u << (bit - 32u);
+                }
+            }
+        }
+    }
+    return m;
+}
+
+// Whether a face's pixel box is small enough for exact masks.
+fn exact_masks(lo: vec2<u32>, hi: vec2<u32>) -> bool {
+    let size = hi - lo + vec2<u32>(1u);
+    return size.x * size.y <= EXACT_MASK_PIXELS;
 }

@@ -1,7 +1,8 @@
 // Projection and culling: one invocation per face builds its `FaceRecord` (barycentric plane,
-// window scale, perspective weights, opacity, colours, tile rectangle) and counts the tiles it
-// touches. Culled faces (behind the near plane, degenerate, covering no pixel centre, face
-// opacity < 0.01) touch no tile. The counts are then scanned into emission offsets.
+// window scale, perspective weights, opacity, colours, pixel box) and counts the tiles whose
+// coverage mask (`tile_mask`) is not empty. Culled faces (behind the near plane, degenerate,
+// reaching no pixel centre with α ≥ alpha_min, face opacity < 0.01) touch no tile. The counts
+// are then scanned into emission offsets.
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
 @group(0) @binding(1) var<storage, read> positions: array<vec4<f32>>;
@@ -17,7 +18,7 @@ fn sigmoid(x: f32) -> f32 {
 
 fn culled(f: u32) {
     var rec = FaceRecord();
-    rec.tiles = vec4<u32>(1u, 0u, 0u, 0u);
+    rec.pixels = vec4<u32>(1u, 0u, 0u, 0u);
     records[f] = rec;
     tile_counts[f] = 0u;
 }
@@ -55,16 +56,16 @@ fn project_faces(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         return;
     }
     // Pixel centres inside the bounding box (centre of pixel i at i + 0.5).
-    let lo = min(s[0], min(s[1], s[2]));
-    let hi = max(s[0], max(s[1], s[2]));
-    let px0 = max(ceil(lo - 0.5), vec2<f32>(0.0));
-    let px1 = min(floor(hi - 0.5), vec2<f32>(f32(params.width) - 1.0, f32(params.height) - 1.0));
+    let s_lo = min(s[0], min(s[1], s[2]));
+    let s_hi = max(s[0], max(s[1], s[2]));
+    let px0 = max(ceil(s_lo - 0.5), vec2<f32>(0.0));
+    let px1 = min(floor(s_hi - 0.5), vec2<f32>(f32(params.width) - 1.0, f32(params.height) - 1.0));
     if (px0.x > px1.x || px0.y > px1.y) {
         culled(f);
         return;
     }
-    let t0 = vec2<u32>(px0) / TILE;
-    let t1 = vec2<u32>(px1) / TILE;
+    let lo = vec2<u32>(px0);
+    let hi = vec2<u32>(px1);
 
     var rec = FaceRecord();
     let inv = 1.0 / area2;
@@ -79,7 +80,23 @@ fn project_faces(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     rec.color1 = colors[idx.y];
     rec.color2 = colors[idx.z];
     rec.verts = vec4<u32>(idx, 0u);
-    rec.tiles = vec4<u32>(t0, t1);
+    rec.pixels = vec4<u32>(lo, hi);
+    // Count the tiles with a non-empty mask, as `emit_pairs` will find them.
+    let t0 = lo / TILE;
+    let t1 = hi / TILE;
+    let exact = exact_masks(lo, hi);
+    let g = face_geometry(rec);
+    var count = 0u;
+    for (var ty = t0.y; ty <= t1.y; ty++) {
+        for (var tx = t0.x; tx <= t1.x; tx++) {
+            let m = tile_mask(g, vec2<u32>(tx, ty), lo, hi, exact, params.gamma, params.alpha_min);
+            count += select(0u, 1u, (m.x | m.y) != 0u);
+        }
+    }
+    if (count == 0u) {
+        culled(f);
+        return;
+    }
     records[f] = rec;
-    tile_counts[f] = (t1.x - t0.x + 1u) * (t1.y - t0.y + 1u);
+    tile_counts[f] = count;
 }

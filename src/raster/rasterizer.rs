@@ -128,8 +128,8 @@ impl Rasterizer {
                 &state.offsets,
                 state.sorter.keys(),
                 state.sorter.values(),
-                &state.pair_face,
-                &state.sorted_face,
+                &state.pair_info,
+                &state.sorted_info,
                 &state.pair_slot,
                 &state.tile_ranges,
             ],
@@ -159,7 +159,7 @@ impl Rasterizer {
             &[
                 &state.params,
                 &state.tile_ranges,
-                &state.sorted_face,
+                &state.sorted_info,
                 &state.records,
                 &field.part_logits,
                 &state.render,
@@ -193,7 +193,7 @@ impl Rasterizer {
             &[
                 &state.params,
                 &state.tile_ranges,
-                &state.sorted_face,
+                &state.sorted_info,
                 &state.records,
                 &field.part_logits,
                 &state.render,

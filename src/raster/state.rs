@@ -111,8 +111,10 @@ pub struct RasterState {
     pub(super) face_stats: wgpu::Buffer,
     pair_capacity: u32,
     pub(super) sorter: RadixSort,
-    pub(super) pair_face: wgpu::Buffer,
-    pub(super) sorted_face: wgpu::Buffer,
+    /// Per emitted pair: face, coverage mask (two words), 0.
+    pub(super) pair_info: wgpu::Buffer,
+    /// `pair_info` in sorted order.
+    pub(super) sorted_info: wgpu::Buffer,
     pub(super) pair_slot: wgpu::Buffer,
     pub(super) pair_grads: wgpu::Buffer,
     pub(super) pair_logit_grads: wgpu::Buffer,
@@ -165,10 +167,14 @@ impl RasterState {
             )?,
             pair_capacity,
             sorter: RadixSort::new(ctx, pair_capacity)?,
-            pair_face: ctx
-                .storage_buffer_zeroed("raster.pair_face", f32_bytes(pair_capacity.into()))?,
-            sorted_face: ctx
-                .storage_buffer_zeroed("raster.sorted_face", f32_bytes(pair_capacity.into()))?,
+            pair_info: ctx.storage_buffer_zeroed(
+                "raster.pair_info",
+                f32_bytes(4 * u64::from(pair_capacity)),
+            )?,
+            sorted_info: ctx.storage_buffer_zeroed(
+                "raster.sorted_info",
+                f32_bytes(4 * u64::from(pair_capacity)),
+            )?,
             pair_slot: ctx
                 .storage_buffer_zeroed("raster.pair_slot", f32_bytes(pair_capacity.into()))?,
             pair_grads: ctx.storage_buffer_zeroed(
@@ -257,12 +263,15 @@ impl RasterState {
     }
 
     /// Counts the work of the last forward pass (for benchmarks): per-pixel face evaluations of
-    /// the forward and backward compositing loops, and the hits (contributions with α ≥ alpha_min)
-    /// as the face statistics recorded them since they were last cleared.
+    /// the forward and backward compositing loops (a pixel evaluates the listed faces whose
+    /// coverage mask holds it), and the hits (contributions with α ≥ alpha_min) as the face
+    /// statistics recorded them since they were last cleared.
     pub async fn read_work(&self, ctx: &GpuContext, faces: u32) -> GpuResult<WorkCounts> {
         let tiles_x = self.width.div_ceil(TILE);
         let tiles = (tiles_x * self.height.div_ceil(TILE)) as usize;
         let ranges: Vec<u32> = ctx.read_buffer(&self.tile_ranges, 2 * tiles).await?;
+        let pairs = self.last_params.num_pairs as usize;
+        let info: Vec<u32> = ctx.read_buffer(&self.sorted_info, 4 * pairs).await?;
         let render = self.read_render(ctx).await?;
         let n = (self.width * self.height) as usize;
         let planes = BASE_CHANNELS + self.num_parts as usize;
@@ -273,16 +282,21 @@ impl RasterState {
         for y in 0..self.height {
             for x in 0..self.width {
                 let tile = ((y / TILE) * tiles_x + x / TILE) as usize;
-                let len = u64::from(ranges[2 * tile + 1].saturating_sub(ranges[2 * tile]));
+                let (start, end) = (ranges[2 * tile] as usize, ranges[2 * tile + 1] as usize);
+                let bit = (y % TILE) * TILE + x % TILE;
                 let i = (y * self.width + x) as usize;
-                let used = u64::from(consumed[i]);
+                let used = consumed[i] as usize;
                 // A saturated pixel stops at its last contributor; the others scan the whole list.
-                forward += if 1.0 - render.plane(4)[i] < t_min {
-                    used
-                } else {
-                    len
-                };
-                backward += used;
+                let saturated = 1.0 - render.plane(4)[i] < t_min;
+                for j in start..end.min(pairs) {
+                    let word = info[4 * j + 1 + (bit / 32) as usize];
+                    if word >> (bit % 32) & 1 == 0 {
+                        continue;
+                    }
+                    let entry = j - start;
+                    forward += u64::from(!saturated || entry < used);
+                    backward += u64::from(entry < used);
+                }
             }
         }
         let hits = self
@@ -343,8 +357,8 @@ impl RasterState {
             f32_bytes(3 * u64::from(self.num_parts) * cap64),
         )?;
         self.sorter = RadixSort::new(ctx, cap)?;
-        self.pair_face = ctx.storage_buffer_zeroed("raster.pair_face", f32_bytes(cap64))?;
-        self.sorted_face = ctx.storage_buffer_zeroed("raster.sorted_face", f32_bytes(cap64))?;
+        self.pair_info = ctx.storage_buffer_zeroed("raster.pair_info", f32_bytes(4 * cap64))?;
+        self.sorted_info = ctx.storage_buffer_zeroed("raster.sorted_info", f32_bytes(4 * cap64))?;
         self.pair_slot = ctx.storage_buffer_zeroed("raster.pair_slot", f32_bytes(cap64))?;
         self.pair_grads =
             ctx.storage_buffer_zeroed("raster.pair_grads", f32_bytes(PAIR_GRADS * cap64))?;
