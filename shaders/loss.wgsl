@@ -1,7 +1,7 @@
 // Image loss of one rendered view against its target, forward and backward in one submission.
 //
 // Buffers are planar: map j of a multi-map buffer lives at [j * npix + pix], pix = y * width + x.
-// Kernels, in dispatch order (one invocation per pixel each):
+// Kernels, in dispatch order (one invocation per SEGMENT pixels of a row or column, see below):
 //   ssim_h      horizontal 11-tap Gaussian blur of x, y, x², y², xy per colour channel -> stats (15 maps)
 //   ssim_v      vertical blur of stats, SSIM and its partials w.r.t. (μx, E[x²], E[xy]) -> dssim (9 maps)
 //   ssim_back_h horizontal blur of dssim -> stats (first 9 maps; the blur is self-adjoint)
@@ -16,7 +16,7 @@ struct LossParams {
     npix: u32,
     num_parts: u32,
     target_offset: u32,  // first u32 of this view in `targets`
-    num_groups: u32,     // workgroups of the per-pixel kernels
+    num_groups: u32,     // workgroups of the vertical (column) kernels, which write partial sums
     depth_count: u32,    // pixels with valid target depth
     label_count: u32,    // pixels with a part label
     background: vec4<f32>,
@@ -103,88 +103,217 @@ fn workgroup_sum(lid: u32, v: vec4<f32>) -> vec4<f32> {
     return total;
 }
 
-@compute @workgroup_size(WG_SIZE)
-fn ssim_h(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
-    let pix = workgroup_index(wg) * WG_SIZE + lid;
-    if (pix >= params.npix) {
-        return;
-    }
+// The SSIM blurs run as sliding windows: one invocation walks SEGMENT consecutive outputs of one
+// line (a row for the horizontal passes, a column for the vertical ones), holding the last 11
+// inputs in registers (r0..r10, shifted by one per step), so each input is loaded once per
+// segment instead of once per tap (11×). Consecutive invocations take consecutive lines: the
+// vertical passes' loads are coalesced on a GPU; on CPU drivers every load is a per-lane gather,
+// which is what this saves. Taps outside the image count as zero (the CPU reference's padding).
+const SEGMENT: u32 = 32u;
+
+// One invocation's run: its line, the first output position on it and how many it owns.
+struct Run {
+    line: u32,
+    first: u32,
+    count: u32,
+    valid: bool,
+}
+
+// `lines` lines of length `len`, SEGMENT outputs per invocation; invocation `id`.
+fn run_of(id: u32, lines: u32, len: u32) -> Run {
+    var r = Run();
+    r.line = id % lines;
+    r.first = (id / lines) * SEGMENT;
+    r.valid = r.first < len;
+    r.count = select(0u, min(SEGMENT, len - r.first), r.valid);
+    return r;
+}
+
+// Pixel index of position `i` on row line / column line.
+fn row_pixel(line: u32, i: u32) -> u32 {
+    return line * params.width + i;
+}
+
+fn column_pixel(line: u32, i: u32) -> u32 {
+    return i * params.width + line;
+}
+
+// Per channel (x, y, x², y²) and the three xy products: what SSIM blurs (15 values).
+struct Moments {
+    r: vec4<f32>,
+    g: vec4<f32>,
+    b: vec4<f32>,
+    xy: vec3<f32>,
+}
+
+fn mad_moments(acc: Moments, w: f32, v: Moments) -> Moments {
+    return Moments(acc.r + w * v.r, acc.g + w * v.g, acc.b + w * v.b, acc.xy + w * v.xy);
+}
+
+// Per channel (∂S/∂μx, ∂S/∂E[x²], ∂S/∂E[xy]) (9 values).
+struct Partials {
+    r: vec3<f32>,
+    g: vec3<f32>,
+    b: vec3<f32>,
+}
+
+fn mad_partials(acc: Partials, w: f32, v: Partials) -> Partials {
+    return Partials(acc.r + w * v.r, acc.g + w * v.g, acc.b + w * v.b);
+}
+
+fn pixel_moments(q: u32) -> Moments {
+    let x = render_rgb(q);
+    let y = load_target(q).rgb;
+    return Moments(
+        vec4<f32>(x.x, y.x, x.x * x.x, y.x * y.x),
+        vec4<f32>(x.y, y.y, x.y * x.y, y.y * y.y),
+        vec4<f32>(x.z, y.z, x.z * x.z, y.z * y.z),
+        x * y,
+    );
+}
+
+// stats: channel c's (μx, μy, E[x²], E[y²], E[xy]) at maps 5c .. 5c + 4.
+fn store_moments(q: u32, m: Moments) {
     let n = params.npix;
-    let px = i32(pix % params.width);
-    let row = pix - u32(px);
-    // Per channel: (μx, μy, E[x²], E[y²]) and E[xy].
-    var acc = array<vec4<f32>, 3>();
-    var acc_xy = vec3<f32>(0.0);
-    for (var k = -RADIUS; k <= RADIUS; k++) {
-        let x = px + k;
-        if (x < 0 || x >= i32(params.width)) {
-            continue;
-        }
-        let q = row + u32(x);
-        let w = tap(k);
-        let xs = render_rgb(q);
-        let ys = load_target(q).rgb;
-        for (var c = 0u; c < 3u; c++) {
-            acc[c] += w * vec4<f32>(xs[c], ys[c], xs[c] * xs[c], ys[c] * ys[c]);
-        }
-        acc_xy += w * xs * ys;
-    }
-    for (var c = 0u; c < 3u; c++) {
-        let base = c * 5u * n + pix;
-        stats[base] = acc[c].x;
-        stats[base + n] = acc[c].y;
-        stats[base + 2u * n] = acc[c].z;
-        stats[base + 3u * n] = acc[c].w;
-        stats[base + 4u * n] = acc_xy[c];
+    let c = array<vec4<f32>, 3>(m.r, m.g, m.b);
+    for (var k = 0u; k < 3u; k++) {
+        let base = k * 5u * n + q;
+        stats[base] = c[k].x;
+        stats[base + n] = c[k].y;
+        stats[base + 2u * n] = c[k].z;
+        stats[base + 3u * n] = c[k].w;
+        stats[base + 4u * n] = m.xy[k];
     }
 }
 
+fn load_moments(q: u32) -> Moments {
+    let n = params.npix;
+    var c = array<vec4<f32>, 3>();
+    var xy = vec3<f32>();
+    for (var k = 0u; k < 3u; k++) {
+        let base = k * 5u * n + q;
+        c[k] = vec4<f32>(stats[base], stats[base + n], stats[base + 2u * n], stats[base + 3u * n]);
+        xy[k] = stats[base + 4u * n];
+    }
+    return Moments(c[0], c[1], c[2], xy);
+}
+
+// Partials live at maps 3c .. 3c + 2 of `dssim` (per pixel) and of `stats` (blurred along rows).
+fn load_dssim(q: u32) -> Partials {
+    let n = params.npix;
+    return Partials(
+        vec3<f32>(dssim[q], dssim[q + n], dssim[q + 2u * n]),
+        vec3<f32>(dssim[3u * n + q], dssim[4u * n + q], dssim[5u * n + q]),
+        vec3<f32>(dssim[6u * n + q], dssim[7u * n + q], dssim[8u * n + q]),
+    );
+}
+
+fn load_blurred_partials(q: u32) -> Partials {
+    let n = params.npix;
+    return Partials(
+        vec3<f32>(stats[q], stats[q + n], stats[q + 2u * n]),
+        vec3<f32>(stats[3u * n + q], stats[4u * n + q], stats[5u * n + q]),
+        vec3<f32>(stats[6u * n + q], stats[7u * n + q], stats[8u * n + q]),
+    );
+}
+
+// The 11 taps, read once per invocation.
+struct Taps {
+    t0: f32, t1: f32, t2: f32, t3: f32, t4: f32, t5: f32, t6: f32, t7: f32, t8: f32, t9: f32, t10: f32,
+}
+
+fn taps() -> Taps {
+    return Taps(tap(-5), tap(-4), tap(-3), tap(-2), tap(-1), tap(0), tap(1), tap(2), tap(3), tap(4), tap(5));
+}
+
+// Horizontal blur of the moments: stats.
+@compute @workgroup_size(WG_SIZE)
+fn ssim_h(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let run = run_of(workgroup_index(wg) * WG_SIZE + lid, params.height, params.width);
+    if (!run.valid || run.line >= params.height) {
+        return;
+    }
+    let t = taps();
+    var r0 = Moments(); var r1 = Moments(); var r2 = Moments(); var r3 = Moments();
+    var r4 = Moments(); var r5 = Moments(); var r6 = Moments(); var r7 = Moments();
+    var r8 = Moments(); var r9 = Moments(); var r10 = Moments();
+    let len = i32(params.width);
+    let first = i32(run.first);
+    for (var i = first - RADIUS; i < first + i32(run.count) + RADIUS; i++) {
+        r0 = r1; r1 = r2; r2 = r3; r3 = r4; r4 = r5; r5 = r6; r6 = r7; r7 = r8; r8 = r9; r9 = r10;
+        r10 = Moments();
+        if (i >= 0 && i < len) {
+            r10 = pixel_moments(row_pixel(run.line, u32(i)));
+        }
+        if (i >= first + RADIUS) {
+            var m = Moments();
+            m = mad_moments(m, t.t0, r0); m = mad_moments(m, t.t1, r1); m = mad_moments(m, t.t2, r2);
+            m = mad_moments(m, t.t3, r3); m = mad_moments(m, t.t4, r4); m = mad_moments(m, t.t5, r5);
+            m = mad_moments(m, t.t6, r6); m = mad_moments(m, t.t7, r7); m = mad_moments(m, t.t8, r8);
+            m = mad_moments(m, t.t9, r9); m = mad_moments(m, t.t10, r10);
+            store_moments(row_pixel(run.line, u32(i - RADIUS)), m);
+        }
+    }
+}
+
+// SSIM of one channel from its blurred moments: Σ(1 − S) term and the partials of S w.r.t.
+// (μx, E[x²], E[xy]) with the target's μy, E[y²] fixed.
+fn ssim_partials(m: vec4<f32>, exy: f32, one_minus: ptr<function, f32>) -> vec3<f32> {
+    let mx = m.x;
+    let my = m.y;
+    let a1 = 2.0 * mx * my + SSIM_C1;
+    let a2 = 2.0 * (exy - mx * my) + SSIM_C2;
+    let b1 = mx * mx + my * my + SSIM_C1;
+    let b2 = (m.z - mx * mx) + (m.w - my * my) + SSIM_C2;
+    let inv = 1.0 / (b1 * b2);
+    let s = a1 * a2 * inv;
+    *one_minus += 1.0 - s;
+    // a1' = 2μy, a2' = (-2μy, 0, 2), b1' = 2μx, b2' = (-2μx, 1, 0).
+    let d_mu = (2.0 * my * (a2 - a1) - 2.0 * mx * s * (b2 - b1)) * inv;
+    let d_xx = -s / b2;
+    let d_xy = 2.0 * a1 * inv;
+    return vec3<f32>(d_mu, d_xx, d_xy);
+}
+
+// Vertical blur of stats, SSIM and its partials: dssim, and Σ(1 − S) per workgroup.
 @compute @workgroup_size(WG_SIZE)
 fn ssim_v(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let wg_index = workgroup_index(wg);
     if (wg_index >= params.num_groups) {
         return;
     }
-    let pix = wg_index * WG_SIZE + lid;
-    let n = params.npix;
+    let run = run_of(wg_index * WG_SIZE + lid, params.width, params.height);
     // Σ (1 - S) rather than Σ S: the sum stays small and 1 - mean S needs no cancelling
     // subtraction, which would cost the term its last digits (finite differences see them).
     var dssim_sum = 0.0;
-    if (pix < n) {
-        let py = i32(pix / params.width);
-        let px = pix % params.width;
-        for (var c = 0u; c < 3u; c++) {
-            var m = vec4<f32>(0.0);  // μx, μy, E[x²], E[y²]
-            var exy = 0.0;
-            for (var k = -RADIUS; k <= RADIUS; k++) {
-                let y = py + k;
-                if (y < 0 || y >= i32(params.height)) {
-                    continue;
-                }
-                let q = u32(y) * params.width + px;
-                let w = tap(k);
-                let base = c * 5u * n + q;
-                m += w * vec4<f32>(stats[base], stats[base + n], stats[base + 2u * n], stats[base + 3u * n]);
-                exy += w * stats[base + 4u * n];
+    if (run.valid && run.line < params.width) {
+        let t = taps();
+        var r0 = Moments(); var r1 = Moments(); var r2 = Moments(); var r3 = Moments();
+        var r4 = Moments(); var r5 = Moments(); var r6 = Moments(); var r7 = Moments();
+        var r8 = Moments(); var r9 = Moments(); var r10 = Moments();
+        let len = i32(params.height);
+        let first = i32(run.first);
+        let n = params.npix;
+        for (var i = first - RADIUS; i < first + i32(run.count) + RADIUS; i++) {
+            r0 = r1; r1 = r2; r2 = r3; r3 = r4; r4 = r5; r5 = r6; r6 = r7; r7 = r8; r8 = r9; r9 = r10;
+            r10 = Moments();
+            if (i >= 0 && i < len) {
+                r10 = load_moments(column_pixel(run.line, u32(i)));
             }
-            let mx = m.x;
-            let my = m.y;
-            let a1 = 2.0 * mx * my + SSIM_C1;
-            let a2 = 2.0 * (exy - mx * my) + SSIM_C2;
-            let b1 = mx * mx + my * my + SSIM_C1;
-            let b2 = (m.z - mx * mx) + (m.w - my * my) + SSIM_C2;
-            let inv = 1.0 / (b1 * b2);
-            let s = a1 * a2 * inv;
-            dssim_sum += 1.0 - s;
-            // S = a1 a2 / (b1 b2) as a function of (μx, E[x²], E[xy]) with the target's μy, E[y²] fixed:
-            // a1' = 2μy, a2' = (-2μy, 0, 2), b1' = 2μx, b2' = (-2μx, 1, 0).
-            let d_mu = (2.0 * my * (a2 - a1) - 2.0 * mx * s * (b2 - b1)) * inv;
-            let d_xx = -s / b2;
-            let d_xy = 2.0 * a1 * inv;
-            let dst = c * 3u * n + pix;
-            dssim[dst] = d_mu;
-            dssim[dst + n] = d_xx;
-            dssim[dst + 2u * n] = d_xy;
+            if (i >= first + RADIUS) {
+                var m = Moments();
+                m = mad_moments(m, t.t0, r0); m = mad_moments(m, t.t1, r1); m = mad_moments(m, t.t2, r2);
+                m = mad_moments(m, t.t3, r3); m = mad_moments(m, t.t4, r4); m = mad_moments(m, t.t5, r5);
+                m = mad_moments(m, t.t6, r6); m = mad_moments(m, t.t7, r7); m = mad_moments(m, t.t8, r8);
+                m = mad_moments(m, t.t9, r9); m = mad_moments(m, t.t10, r10);
+                let q = column_pixel(run.line, u32(i - RADIUS));
+                let dr = ssim_partials(m.r, m.xy.x, &dssim_sum);
+                let dg = ssim_partials(m.g, m.xy.y, &dssim_sum);
+                let db = ssim_partials(m.b, m.xy.z, &dssim_sum);
+                dssim[q] = dr.x; dssim[q + n] = dr.y; dssim[q + 2u * n] = dr.z;
+                dssim[3u * n + q] = dg.x; dssim[4u * n + q] = dg.y; dssim[5u * n + q] = dg.z;
+                dssim[6u * n + q] = db.x; dssim[7u * n + q] = db.y; dssim[8u * n + q] = db.z;
+            }
         }
     }
     let total = workgroup_sum(lid, vec4<f32>(dssim_sum, 0.0, 0.0, 0.0));
@@ -193,62 +322,46 @@ fn ssim_v(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     }
 }
 
+// Horizontal blur of dssim into the first 9 maps of stats (the blur is self-adjoint).
 @compute @workgroup_size(WG_SIZE)
 fn ssim_back_h(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
-    let pix = workgroup_index(wg) * WG_SIZE + lid;
-    if (pix >= params.npix) {
+    let run = run_of(workgroup_index(wg) * WG_SIZE + lid, params.height, params.width);
+    if (!run.valid || run.line >= params.height) {
         return;
     }
+    let t = taps();
+    var r0 = Partials(); var r1 = Partials(); var r2 = Partials(); var r3 = Partials();
+    var r4 = Partials(); var r5 = Partials(); var r6 = Partials(); var r7 = Partials();
+    var r8 = Partials(); var r9 = Partials(); var r10 = Partials();
+    let len = i32(params.width);
+    let first = i32(run.first);
     let n = params.npix;
-    let px = i32(pix % params.width);
-    let row = pix - u32(px);
-    var acc = array<vec3<f32>, 3>();
-    for (var k = -RADIUS; k <= RADIUS; k++) {
-        let x = px + k;
-        if (x < 0 || x >= i32(params.width)) {
-            continue;
+    for (var i = first - RADIUS; i < first + i32(run.count) + RADIUS; i++) {
+        r0 = r1; r1 = r2; r2 = r3; r3 = r4; r4 = r5; r5 = r6; r6 = r7; r7 = r8; r8 = r9; r9 = r10;
+        r10 = Partials();
+        if (i >= 0 && i < len) {
+            r10 = load_dssim(row_pixel(run.line, u32(i)));
         }
-        let q = row + u32(x);
-        let w = tap(k);
-        for (var c = 0u; c < 3u; c++) {
-            let base = c * 3u * n + q;
-            acc[c] += w * vec3<f32>(dssim[base], dssim[base + n], dssim[base + 2u * n]);
+        if (i >= first + RADIUS) {
+            var m = Partials();
+            m = mad_partials(m, t.t0, r0); m = mad_partials(m, t.t1, r1); m = mad_partials(m, t.t2, r2);
+            m = mad_partials(m, t.t3, r3); m = mad_partials(m, t.t4, r4); m = mad_partials(m, t.t5, r5);
+            m = mad_partials(m, t.t6, r6); m = mad_partials(m, t.t7, r7); m = mad_partials(m, t.t8, r8);
+            m = mad_partials(m, t.t9, r9); m = mad_partials(m, t.t10, r10);
+            let q = row_pixel(run.line, u32(i - RADIUS));
+            stats[q] = m.r.x; stats[q + n] = m.r.y; stats[q + 2u * n] = m.r.z;
+            stats[3u * n + q] = m.g.x; stats[4u * n + q] = m.g.y; stats[5u * n + q] = m.g.z;
+            stats[6u * n + q] = m.b.x; stats[7u * n + q] = m.b.y; stats[8u * n + q] = m.b.z;
         }
-    }
-    for (var c = 0u; c < 3u; c++) {
-        let base = c * 3u * n + pix;
-        stats[base] = acc[c].x;
-        stats[base + n] = acc[c].y;
-        stats[base + 2u * n] = acc[c].z;
     }
 }
 
-@compute @workgroup_size(WG_SIZE)
-fn pixel(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
-    let wg_index = workgroup_index(wg);
-    if (wg_index >= params.num_groups) {
-        return;
-    }
-    let pix = wg_index * WG_SIZE + lid;
+// Every term's gradient at one pixel given its vertically blurred SSIM partials (per channel
+// Σ g ∂S/∂μx, Σ g ∂S/∂E[x²], Σ g ∂S/∂E[xy]); returns its (l1, depth, part, mask) sums.
+fn pixel_terms(pix: u32, blurred: array<vec3<f32>, 3>) -> vec4<f32> {
     let n = params.npix;
-    // l1, depth, part, mask sums of this pixel
     var here = vec4<f32>(0.0);
-    if (pix < n) {
-        let py = i32(pix / params.width);
-        let px = pix % params.width;
-        var blurred = array<vec3<f32>, 3>();  // per channel: Σ g ∂S/∂μx, Σ g ∂S/∂E[x²], Σ g ∂S/∂E[xy]
-        for (var k = -RADIUS; k <= RADIUS; k++) {
-            let y = py + k;
-            if (y < 0 || y >= i32(params.height)) {
-                continue;
-            }
-            let q = u32(y) * params.width + px;
-            let w = tap(k);
-            for (var c = 0u; c < 3u; c++) {
-                let base = c * 3u * n + q;
-                blurred[c] += w * vec3<f32>(stats[base], stats[base + n], stats[base + 2u * n]);
-            }
-        }
+    {
         let t = load_target(pix);
         let xs = render_rgb(pix);
         let inv_colour = 1.0 / f32(3u * n);
@@ -296,6 +409,42 @@ fn pixel(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         } else {
             for (var j = 0u; j < params.num_parts; j++) {
                 grad[logits + j * n] = 0.0;
+            }
+        }
+    }
+    return here;
+}
+
+// Vertical blur of the row-blurred partials, then every term's gradient: grad, and the
+// (l1, depth, part, mask) sums per workgroup.
+@compute @workgroup_size(WG_SIZE)
+fn pixel(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
+    let wg_index = workgroup_index(wg);
+    if (wg_index >= params.num_groups) {
+        return;
+    }
+    let run = run_of(wg_index * WG_SIZE + lid, params.width, params.height);
+    var here = vec4<f32>(0.0);
+    if (run.valid && run.line < params.width) {
+        let t = taps();
+        var r0 = Partials(); var r1 = Partials(); var r2 = Partials(); var r3 = Partials();
+        var r4 = Partials(); var r5 = Partials(); var r6 = Partials(); var r7 = Partials();
+        var r8 = Partials(); var r9 = Partials(); var r10 = Partials();
+        let len = i32(params.height);
+        let first = i32(run.first);
+        for (var i = first - RADIUS; i < first + i32(run.count) + RADIUS; i++) {
+            r0 = r1; r1 = r2; r2 = r3; r3 = r4; r4 = r5; r5 = r6; r6 = r7; r7 = r8; r8 = r9; r9 = r10;
+            r10 = Partials();
+            if (i >= 0 && i < len) {
+                r10 = load_blurred_partials(column_pixel(run.line, u32(i)));
+            }
+            if (i >= first + RADIUS) {
+                var m = Partials();
+                m = mad_partials(m, t.t0, r0); m = mad_partials(m, t.t1, r1); m = mad_partials(m, t.t2, r2);
+                m = mad_partials(m, t.t3, r3); m = mad_partials(m, t.t4, r4); m = mad_partials(m, t.t5, r5);
+                m = mad_partials(m, t.t6, r6); m = mad_partials(m, t.t7, r7); m = mad_partials(m, t.t8, r8);
+                m = mad_partials(m, t.t9, r9); m = mad_partials(m, t.t10, r10);
+                here += pixel_terms(column_pixel(run.line, u32(i - RADIUS)), array<vec3<f32>, 3>(m.r, m.g, m.b));
             }
         }
     }

@@ -154,7 +154,22 @@ pub struct ImageLoss {
     width: u32,
     height: u32,
     num_parts: u32,
+    /// Workgroups of the column kernels (`ssim_v`, `pixel`), which write partial sums.
     num_groups: u32,
+    /// Workgroups of the row kernels (`ssim_h`, `ssim_back_h`).
+    row_groups: u32,
+}
+
+/// Pixels one invocation of the blur kernels walks along its row or column (`SEGMENT` in
+/// `loss.wgsl`).
+const BLUR_SEGMENT: u32 = 32;
+
+/// Workgroups of the column kernels and of the row kernels for a `width`×`height` image.
+fn blur_groups(width: u32, height: u32) -> (u32, u32) {
+    let columns = u64::from(width) * u64::from(height.div_ceil(BLUR_SEGMENT));
+    let rows = u64::from(height) * u64::from(width.div_ceil(BLUR_SEGMENT));
+    let groups = |n: u64| n.div_ceil(u64::from(WG_SIZE)) as u32;
+    (groups(columns), groups(rows))
 }
 
 impl ImageLoss {
@@ -169,7 +184,7 @@ impl ImageLoss {
         }
         let stats = ctx.storage_buffer_zeroed("loss.stats", 15 * npix * 4)?;
         let dssim = ctx.storage_buffer_zeroed("loss.dssim", 9 * npix * 4)?;
-        let num_groups = npix.div_ceil(u64::from(WG_SIZE)) as u32;
+        let (num_groups, row_groups) = blur_groups(width, height);
         let sums = ctx.storage_buffer_zeroed(
             "loss.sums",
             u64::from(num_groups) * u64::from(SUMS_STRIDE) * 4,
@@ -208,6 +223,7 @@ impl ImageLoss {
             height,
             num_parts,
             num_groups,
+            row_groups,
         })
     }
 
@@ -333,9 +349,10 @@ impl ImageLoss {
             ],
         );
         let mut pass = crate::gpu::compute_pass(encoder, "loss");
-        for pipeline in [&self.ssim_h, &self.ssim_v, &self.ssim_back_h, &self.pixel] {
-            ctx.dispatch(&mut pass, pipeline, &bind_group, self.num_groups);
-        }
+        ctx.dispatch(&mut pass, &self.ssim_h, &bind_group, self.row_groups);
+        ctx.dispatch(&mut pass, &self.ssim_v, &bind_group, self.num_groups);
+        ctx.dispatch(&mut pass, &self.ssim_back_h, &bind_group, self.row_groups);
+        ctx.dispatch(&mut pass, &self.pixel, &bind_group, self.num_groups);
         ctx.dispatch(&mut pass, &self.finalize, &bind_group, 1);
         Ok(())
     }
