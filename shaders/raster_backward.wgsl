@@ -4,10 +4,11 @@
 // pixel's final output and P_n the accumulation up to and including face n,
 //   dO/dα_n = q_n T_n − (O − P_n) / (1 − α_n),   dO/dq_n = α_n T_n,
 // so no reverse traversal or division by T is needed. A face's gradient (w.r.t. its record's
-// barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part logits) is summed
-// over the tile's pixels in workgroup memory
-// (compare-exchange on f32 bits: the browser has no float atomics), and written once per
-// (face, tile) pair, at its sorted slot.
+// barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part logits) is written
+// per (face, tile) pair, at its sorted slot, into buffers cleared beforehand: straight from the
+// one invocation whose pixel it covers when its mask has a single bit (most pairs: faces are a
+// pixel or two), otherwise summed over the tile's pixels in workgroup memory first
+// (compare-exchange on f32 bits: the browser has no float atomics).
 //
 // Pair gradient layout (PAIR_GRADS floats): 0–2 dL/da_i.x, 3–5 dL/da_i.y, 6–8 Σ dL/dλ_i,
 // 9–11 dL/dk_i, 12–14 dL/d(1/w_i), 15 dL/dσ, 16–24 dL/dcolour_i (i major); part logits in their
@@ -112,7 +113,8 @@ fn start_pixel(px: u32, py: u32) -> Pixel {
 }
 
 // Replays staged face `b` at pixel `s`, adding its gradient to `fg`.
-fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeometry, b: u32) {
+// `direct`: write part-logit gradients straight to sorted pair `slot` instead of summing them.
+fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeometry, b: u32, direct: bool, slot: u32) {
     let hit = evaluate_face(geom, (*s).p, params.gamma, params.alpha_min);
     if (hit.alpha <= 0.0) {
         return;
@@ -142,9 +144,16 @@ fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeom
         g_a += gk * (sk * t - ((*s).out_logits[k] - (*s).pre_logits[k]) / one_minus);
         let gs = gk * w;
         g_mu += gs * sv;
-        add_acc_logit(logit_base + k, mu.x * gs);
-        add_acc_logit(logit_base + parts + k, mu.y * gs);
-        add_acc_logit(logit_base + 2u * parts + k, mu.z * gs);
+        if (direct) {
+            let base = slot * 3u * parts;
+            pair_logit_grads[base + k] = mu.x * gs;
+            pair_logit_grads[base + parts + k] = mu.y * gs;
+            pair_logit_grads[base + 2u * parts + k] = mu.z * gs;
+        } else {
+            add_acc_logit(logit_base + k, mu.x * gs);
+            add_acc_logit(logit_base + parts + k, mu.y * gs);
+            add_acc_logit(logit_base + 2u * parts + k, mu.z * gs);
+        }
     }
     // α = min(0.99, σ φ), φ = u^γ.
     let g_sp = select(g_a, 0.0, hit.clamped);
@@ -183,6 +192,32 @@ fn flush(fg: FaceGrad, b: u32) {
     add_acc(base + 15u, fg.sigma);
 }
 
+// Writes a single-pixel face's gradient (all but the part logits) to sorted pair `slot`.
+fn store_pair(fg: FaceGrad, slot: u32) {
+    let base = slot * PAIR_GRADS;
+    for (var i = 0u; i < 3u; i++) {
+        pair_grads[base + i] = fg.ax[i];
+        pair_grads[base + 3u + i] = fg.ay[i];
+        pair_grads[base + 6u + i] = fg.lambda[i];
+        pair_grads[base + 9u + i] = fg.k[i];
+        pair_grads[base + 12u + i] = fg.inv_w[i];
+        pair_grads[base + 16u + i] = fg.color0[i];
+        pair_grads[base + 19u + i] = fg.color1[i];
+        pair_grads[base + 22u + i] = fg.color2[i];
+    }
+    pair_grads[base + 15u] = fg.sigma;
+}
+
+// The staged faces whose mask has a single bit (bit b for batch slot b).
+fn single_pixel_faces(count: u32) -> u32 {
+    var word = 0u;
+    for (var b = 0u; b < count; b++) {
+        let m = batch_mask[b];
+        word |= select(0u, 1u, countOneBits(m.x) + countOneBits(m.y) == 1u) << b;
+    }
+    return word;
+}
+
 @compute @workgroup_size(INVOCATIONS)
 fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
     let tile = workgroup_index(wg);
@@ -198,6 +233,7 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
         workgroupBarrier();
         let count = min(BATCH, r.y - start);
         var word = covering_faces(lid, count);
+        let single = single_pixel_faces(count);
         loop {
             if (word == 0u || s.done) {
                 break;
@@ -209,18 +245,27 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
                 break;
             }
             var fg = FaceGrad();
-            backprop(&s, &fg, batch[b], b);
+            let direct = ((single >> b) & 1u) != 0u;
+            backprop(&s, &fg, batch[b], b, direct, start + b);
             if (fg.hit) {
-                flush(fg, b);
+                if (direct) {
+                    store_pair(fg, start + b);
+                } else {
+                    flush(fg, b);
+                }
             }
         }
         workgroupBarrier();
-        // Write this batch's sums (and zero them for the next batch).
+        // Write this batch's sums of multi-pixel faces (and zero them for the next batch).
         for (var i = lid; i < count * PAIR_GRADS; i += INVOCATIONS) {
-            pair_grads[start * PAIR_GRADS + i] = bitcast<f32>(atomicExchange(&acc[i], 0u));
+            if (((single >> (i / PAIR_GRADS)) & 1u) == 0u) {
+                pair_grads[start * PAIR_GRADS + i] = bitcast<f32>(atomicExchange(&acc[i], 0u));
+            }
         }
         for (var i = lid; i < count * logit_stride; i += INVOCATIONS) {
-            pair_logit_grads[start * logit_stride + i] = bitcast<f32>(atomicExchange(&acc_logits[i], 0u));
+            if (((single >> (i / logit_stride)) & 1u) == 0u) {
+                pair_logit_grads[start * logit_stride + i] = bitcast<f32>(atomicExchange(&acc_logits[i], 0u));
+            }
         }
     }
 }

@@ -187,6 +187,9 @@ impl Rasterizer {
     ) {
         let params = state.last_params;
         state.clock.start();
+        // Pairs that no pixel reached are never written: they must read as zero.
+        encoder.clear_buffer(&state.pair_grads, 0, None);
+        encoder.clear_buffer(&state.pair_logit_grads, 0, None);
         self.backward.run(
             ctx,
             encoder,
