@@ -5,7 +5,7 @@
 //   dO/dα_n = q_n T_n − (O − P_n) / (1 − α_n),   dO/dq_n = α_n T_n,
 // so no reverse traversal or division by T is needed. A face's gradient (w.r.t. its record's
 // barycentric plane, window scale, 1/w, opacity, vertex colours and vertex part logits) is written
-// per (face, tile) pair, at its sorted slot, into buffers cleared beforehand: straight from the
+// per (face, tile) pair, at its emission index, into buffers cleared beforehand: straight from the
 // one invocation whose pixel it covers when its mask has a single bit (most pairs: faces are a
 // pixel or two), otherwise summed over the tile's pixels in workgroup memory first
 // (compare-exchange on f32 bits: the browser has no float atomics).
@@ -113,7 +113,7 @@ fn start_pixel(px: u32, py: u32) -> Pixel {
 }
 
 // Replays staged face `b` at pixel `s`, adding its gradient to `fg`.
-// `direct`: write part-logit gradients straight to sorted pair `slot` instead of summing them.
+// `direct`: write part-logit gradients straight to pair `slot` (emission index) instead of summing them.
 fn backprop(s: ptr<function, Pixel>, fg: ptr<function, FaceGrad>, geom: FaceGeometry, b: u32, direct: bool, slot: u32) {
     let hit = evaluate_face(geom, (*s).p, params.gamma, params.alpha_min);
     if (hit.alpha <= 0.0) {
@@ -192,7 +192,7 @@ fn flush(fg: FaceGrad, b: u32) {
     add_acc(base + 15u, fg.sigma);
 }
 
-// Writes a single-pixel face's gradient (all but the part logits) to sorted pair `slot`.
+// Writes a single-pixel face's gradient (all but the part logits) to pair `slot` (emission index).
 fn store_pair(fg: FaceGrad, slot: u32) {
     let base = slot * PAIR_GRADS;
     for (var i = 0u; i < 3u; i++) {
@@ -246,10 +246,10 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
             }
             var fg = FaceGrad();
             let direct = ((single >> b) & 1u) != 0u;
-            backprop(&s, &fg, batch[b], b, direct, start + b);
+            backprop(&s, &fg, batch[b], b, direct, batch_pair[b]);
             if (fg.hit) {
                 if (direct) {
-                    store_pair(fg, start + b);
+                    store_pair(fg, batch_pair[b]);
                 } else {
                     flush(fg, b);
                 }
@@ -258,13 +258,17 @@ fn composite_backward(@builtin(local_invocation_index) lid: u32, wg: Workgroup) 
         workgroupBarrier();
         // Write this batch's sums of multi-pixel faces (and zero them for the next batch).
         for (var i = lid; i < count * PAIR_GRADS; i += INVOCATIONS) {
-            if (((single >> (i / PAIR_GRADS)) & 1u) == 0u) {
-                pair_grads[start * PAIR_GRADS + i] = bitcast<f32>(atomicExchange(&acc[i], 0u));
+            let b = i / PAIR_GRADS;
+            if (((single >> b) & 1u) == 0u) {
+                let dst = batch_pair[b] * PAIR_GRADS + i % PAIR_GRADS;
+                pair_grads[dst] = bitcast<f32>(atomicExchange(&acc[i], 0u));
             }
         }
         for (var i = lid; i < count * logit_stride; i += INVOCATIONS) {
-            if (((single >> (i / logit_stride)) & 1u) == 0u) {
-                pair_logit_grads[start * logit_stride + i] = bitcast<f32>(atomicExchange(&acc_logits[i], 0u));
+            let b = i / logit_stride;
+            if (((single >> b) & 1u) == 0u) {
+                let dst = batch_pair[b] * logit_stride + i % logit_stride;
+                pair_logit_grads[dst] = bitcast<f32>(atomicExchange(&acc_logits[i], 0u));
             }
         }
     }

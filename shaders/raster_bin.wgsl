@@ -1,9 +1,9 @@
 // Tile binning. `emit_pairs` (one invocation per face) writes a (tile, depth) sort key for every
 // tile where the face's coverage mask is not empty, at the face's scanned offset, with the face
 // and its mask; after the radix sort, `tile_ranges` (one invocation per sorted pair) records each
-// tile's [start, end) in the sorted list, the face and mask of every sorted slot, and the sorted
-// slot of every emitted pair (so gradients written per sorted slot can be gathered per face
-// without atomics).
+// tile's [start, end) in the sorted list and the face, mask and emission index of every sorted
+// slot (the backward pass writes each pair's gradient at its emission index, so a face's pairs
+// are contiguous and are gathered without atomics).
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
 @group(0) @binding(1) var<storage, read> records: array<FaceRecord>;
@@ -11,9 +11,8 @@
 @group(0) @binding(3) var<storage, read_write> keys: array<u32>;     // the sorter's keys
 @group(0) @binding(4) var<storage, read_write> values: array<u32>;   // the sorter's values: emission index
 @group(0) @binding(5) var<storage, read_write> pair_info: array<vec4<u32>>;   // emission index -> face, mask (2 words), 0
-@group(0) @binding(6) var<storage, read_write> sorted_info: array<vec4<u32>>; // sorted slot -> face, mask, 0
-@group(0) @binding(7) var<storage, read_write> pair_slot: array<u32>;   // emission index -> sorted slot
-@group(0) @binding(8) var<storage, read_write> tile_ranges: array<u32>; // 2 per tile: start, end
+@group(0) @binding(6) var<storage, read_write> sorted_info: array<vec4<u32>>; // sorted slot -> face, mask, emission index
+@group(0) @binding(7) var<storage, read_write> tile_ranges: array<u32>; // 2 per tile: start, end
 
 fn depth_key(depth: f32) -> u32 {
     let mask = (1u << params.depth_bits) - 1u;
@@ -75,8 +74,7 @@ fn find_tile_ranges(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         return;
     }
     let e = values[j];
-    sorted_info[j] = pair_info[e];
-    pair_slot[e] = j;
+    sorted_info[j] = vec4<u32>(pair_info[e].xyz, e);
     let tile = tile_of(j);
     if (j == 0u || tile_of(j - 1u) != tile) {
         tile_ranges[2u * tile] = j;

@@ -1,6 +1,5 @@
 // Per-face gradient gather and chain rule, one invocation per face: sums the face's (face, tile)
-// pair gradients (found through the scanned emission offsets and each emission's sorted slot:
-// deterministic, no atomics), then differentiates the face record's construction back to the
+// pair gradients (contiguous at the face's scanned emission offsets: deterministic, no atomics), then differentiates the face record's construction back to the
 // three vertices: barycentric plane and window scale → projected vertices → camera space
 // → world positions; 1/w → view depth; σ → opacity logits. Writes one corner record per face
 // corner: [dL/dx (3), dL/d opacity logit, dL/dcolour (3), 0, dL/d part logits (P)].
@@ -10,10 +9,9 @@
 @group(0) @binding(2) var<storage, read> faces: array<u32>;
 @group(0) @binding(3) var<storage, read> opacity: array<f32>;
 @group(0) @binding(4) var<storage, read> offsets: array<u32>;
-@group(0) @binding(5) var<storage, read> pair_slot: array<u32>;
-@group(0) @binding(6) var<storage, read> pair_grads: array<f32>;
-@group(0) @binding(7) var<storage, read> pair_logit_grads: array<f32>;
-@group(0) @binding(8) var<storage, read_write> corner_grads: array<f32>;
+@group(0) @binding(5) var<storage, read> pair_grads: array<f32>;        // per emitted pair
+@group(0) @binding(6) var<storage, read> pair_logit_grads: array<f32>;
+@group(0) @binding(7) var<storage, read_write> corner_grads: array<f32>;
 
 fn sigmoid(x: f32) -> f32 {
     return 1.0 / (1.0 + exp(-x));
@@ -32,9 +30,8 @@ fn face_gradients(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
 
     var g = array<f32, PAIR_GRADS>();
     for (var e = first; e < last; e++) {
-        let j = pair_slot[e];
         for (var c = 0u; c < PAIR_GRADS; c++) {
-            g[c] += pair_grads[j * PAIR_GRADS + c];
+            g[c] += pair_grads[e * PAIR_GRADS + c];
         }
     }
     for (var i = 0u; i < 3u; i++) {
@@ -42,7 +39,7 @@ fn face_gradients(@builtin(local_invocation_index) lid: u32, wg: Workgroup) {
         for (var k = 0u; k < parts; k++) {
             var sum = 0.0;
             for (var e = first; e < last; e++) {
-                sum += pair_logit_grads[pair_slot[e] * 3u * parts + i * parts + k];
+                sum += pair_logit_grads[e * 3u * parts + i * parts + k];
             }
             corner_grads[corner + CORNER_GRADS + k] = sum;
         }

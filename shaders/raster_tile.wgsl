@@ -7,7 +7,7 @@
 
 @group(0) @binding(0) var<uniform> params: RasterParams;
 @group(0) @binding(1) var<storage, read> tile_ranges: array<u32>;
-@group(0) @binding(2) var<storage, read> sorted_info: array<vec4<u32>>;  // face, mask (2 words), 0
+@group(0) @binding(2) var<storage, read> sorted_info: array<vec4<u32>>;  // face, mask (2 words), emission index
 @group(0) @binding(3) var<storage, read> records: array<FaceRecord>;
 @group(0) @binding(4) var<storage, read> part_logits: array<f32>;   // [vertex][part]
 
@@ -15,6 +15,7 @@ const BATCH: u32 = 32u;
 var<workgroup> batch: array<FaceGeometry, BATCH>;
 var<workgroup> batch_face: array<u32, BATCH>;
 var<workgroup> batch_mask: array<vec2<u32>, BATCH>;
+var<workgroup> batch_pair: array<u32, BATCH>;  // emission index, where the pair's gradient goes
 var<workgroup> range: vec2<u32>;
 
 // The tile's [start, end) in the sorted list, uniform across the workgroup.
@@ -51,6 +52,7 @@ fn stage_batch(start: u32, end: u32, lid: u32, invocations: u32) {
         let info = sorted_info[start + i];
         batch_face[i] = info.x;
         batch_mask[i] = info.yz;
+        batch_pair[i] = info.w;
         batch[i] = face_geometry(records[info.x]);
     }
 }

@@ -187,7 +187,7 @@ impl Kernel {
             ctx,
             "raster_face_grad",
             include_str!("../../shaders/raster_face_grad.wgsl"),
-            &[U, R, R, R, R, R, R, R, RW],
+            &[U, R, R, R, R, R, R, RW],
             "face_gradients",
         )
     }
@@ -217,7 +217,7 @@ impl BinKernels {
             ctx,
             "raster_bin",
             include_str!("../../shaders/raster_bin.wgsl"),
-            &[U, R, R, RW, RW, RW, RW, RW, RW],
+            &[U, R, R, RW, RW, RW, RW, RW],
             ["emit_pairs", "find_tile_ranges"],
         );
         Self {

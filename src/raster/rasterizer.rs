@@ -130,7 +130,6 @@ impl Rasterizer {
                 state.sorter.values(),
                 &state.pair_info,
                 &state.sorted_info,
-                &state.pair_slot,
                 &state.tile_ranges,
             ],
         );
@@ -216,7 +215,6 @@ impl Rasterizer {
                 &field.faces,
                 &field.opacity,
                 &state.offsets,
-                &state.pair_slot,
                 &state.pair_grads,
                 &state.pair_logit_grads,
                 &state.corner_grads,

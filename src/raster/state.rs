@@ -115,7 +115,6 @@ pub struct RasterState {
     pub(super) pair_info: wgpu::Buffer,
     /// `pair_info` in sorted order.
     pub(super) sorted_info: wgpu::Buffer,
-    pub(super) pair_slot: wgpu::Buffer,
     pub(super) pair_grads: wgpu::Buffer,
     pub(super) pair_logit_grads: wgpu::Buffer,
     /// Per-stage timing, off unless [`RasterState::set_profiling`].
@@ -175,8 +174,6 @@ impl RasterState {
                 "raster.sorted_info",
                 f32_bytes(4 * u64::from(pair_capacity)),
             )?,
-            pair_slot: ctx
-                .storage_buffer_zeroed("raster.pair_slot", f32_bytes(pair_capacity.into()))?,
             pair_grads: ctx.storage_buffer_zeroed(
                 "raster.pair_grads",
                 f32_bytes(PAIR_GRADS * u64::from(pair_capacity)),
@@ -359,7 +356,6 @@ impl RasterState {
         self.sorter = RadixSort::new(ctx, cap)?;
         self.pair_info = ctx.storage_buffer_zeroed("raster.pair_info", f32_bytes(4 * cap64))?;
         self.sorted_info = ctx.storage_buffer_zeroed("raster.sorted_info", f32_bytes(4 * cap64))?;
-        self.pair_slot = ctx.storage_buffer_zeroed("raster.pair_slot", f32_bytes(cap64))?;
         self.pair_grads =
             ctx.storage_buffer_zeroed("raster.pair_grads", f32_bytes(PAIR_GRADS * cap64))?;
         self.pair_logit_grads = ctx.storage_buffer_zeroed(
