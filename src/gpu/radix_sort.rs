@@ -9,14 +9,14 @@
 use bytemuck::{Pod, Zeroable};
 
 use super::kernel::{Binding, KernelFamily, compute_pass};
-use super::scan::{PrefixSum, SCAN_BLOCK};
+use super::scan::PrefixSum;
 use super::{GpuContext, GpuError, GpuResult};
 
 const RADIX_BITS: u32 = 8;
 const RADIX: u32 = 1 << RADIX_BITS;
 const MAX_PASSES: usize = (32 / RADIX_BITS) as usize;
-/// Keys per workgroup in `radix_sort.wgsl`; equal to the scan block by construction.
-const SORT_BLOCK: u32 = SCAN_BLOCK;
+/// Keys per workgroup in `radix_sort.wgsl` (`BLOCK` = 256 invocations × 16 keys).
+const SORT_BLOCK: u32 = 4096;
 
 /// Uniform block of `radix_sort.wgsl`.
 #[repr(C)]
