@@ -5,12 +5,13 @@
 //! of its surface) are test fixtures, kept outside the pipeline.
 //!
 //! Files: `config` (the schedule and the curve), `adam` (Adam over the field's parameter
-//! groups), `image` (targets and the loss's backward pass), `trainer` (the training state);
+//! groups), `image` (targets and the loss's backward pass), `trainer` (the training state), `timing` (the rasterizer's training-iteration benchmark);
 //! this file runs a whole fit and renders its preview strip.
 
 mod adam;
 mod config;
 mod image;
+pub mod timing;
 mod trainer;
 
 pub use adam::{FieldAdam, FieldLearningRates};
