@@ -46,8 +46,8 @@ pub struct RasterTiming {
     pub work: WorkCounts,
     /// Pixel–face evaluations (forward + backward) per second of the median iteration.
     pub evaluations_per_second: f64,
-    /// Hits (contributions with α ≥ alpha_min) per pixel–face evaluation, forward and backward
-    /// together: 1.0 when every evaluation contributes.
+    /// Hits (contributions with α ≥ alpha_min) per pixel–face evaluation of the forward pass:
+    /// 1.0 when every evaluation contributes (the backward pass replays only the forward's hits).
     pub hit_rate: f64,
     /// Model FLOPs of the compositing loops per iteration (see `flop_model`).
     pub model_flops: f64,
@@ -178,7 +178,7 @@ async fn time_case(
         stages_ms: stages,
         work,
         evaluations_per_second: evaluations as f64 / (median_ms / 1e3),
-        hit_rate: work.hits as f64 / evaluations.max(1) as f64,
+        hit_rate: work.hits as f64 / work.forward_evaluations.max(1) as f64,
         model_flops: flops,
         gflops_iteration,
         gflops_compositing,
