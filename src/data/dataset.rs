@@ -6,8 +6,9 @@ use super::camera::Camera;
 use super::error::{DataError, DatasetErrors, Errors};
 use super::frame::{Frame, size_error};
 use super::gt::{self, GtJoint, GtMeshes, implied_num_parts, write_ground_truth};
-use super::image_io;
+use super::image_io::{self, DepthMap, PartMap, RgbaImage};
 use super::npy;
+use super::parallel;
 use super::paths;
 use super::ply::TriMesh;
 use super::transforms::{self, FrameSpec};
@@ -171,8 +172,10 @@ fn read_view_set(
     let spec = transforms::parse(file, bytes, errs)?;
     let mut checks = SplitChecks::default();
     let mut frames = Vec::with_capacity(spec.frames.len());
-    for fs in &spec.frames {
-        if let Some(frame) = read_frame(files, file, fs, state, part_limit, &mut checks, errs) {
+    // Decoding is most of a large dataset's reading: all frames at once, then checked in order.
+    let decoded = parallel::map(&spec.frames, |fs| decode_frame(files, fs));
+    for (fs, decoded) in spec.frames.iter().zip(decoded) {
+        if let Some(frame) = read_frame(file, fs, decoded, state, part_limit, &mut checks, errs) {
             frames.push(frame);
         }
     }
@@ -198,62 +201,115 @@ fn read_view_set(
     })
 }
 
-/// Finds and reads the optional depth or semantic file of a frame (`k`: 0 depth, 1 semantic).
-fn sibling_file<'a>(
-    files: &'a FileSet,
-    rgba_path: &str,
-    k: usize,
-    checks: &mut SplitChecks,
-) -> Option<(String, &'a [u8])> {
-    let (kind, exts): (&str, &[&str]) = if k == 0 {
-        ("depth", &[".png"])
-    } else {
-        ("semantic", &[".png", ".npy"])
-    };
-    let candidates: Vec<String> = exts
-        .iter()
-        .filter_map(|e| paths::sibling(rgba_path, kind, e))
-        .collect();
-    let found = candidates
-        .iter()
-        .find_map(|p| files.get(p).map(|b| (p.clone(), b.as_slice())));
-    match &found {
-        Some((p, _)) => checks.present[k].push(p.clone()),
-        None => checks.missing[k].push(
-            candidates
-                .into_iter()
-                .next()
-                .unwrap_or_else(|| rgba_path.to_string()),
-        ),
-    }
-    found
+/// A found-and-decoded optional file of a frame (its path and decoding, each `Err` naming the
+/// file), or the path it was expected at.
+type Found<T> = Result<(String, Result<T, DataError>), String>;
+
+/// A frame's files found and decoded, before any check.
+struct DecodedFrame {
+    /// The colour image's path and decoding, or every path it was looked for under.
+    rgba: Result<(String, Result<RgbaImage, DataError>), Vec<String>>,
+    /// Depth and semantic map; none when the colour image itself is missing.
+    depth: Option<Found<DepthMap>>,
+    parts: Option<Found<PartMap>>,
 }
 
-fn read_frame(
-    files: &FileSet,
-    file: &str,
-    fs: &FrameSpec,
-    state: State,
-    part_limit: Option<usize>,
-    checks: &mut SplitChecks,
-    errs: &mut Errors,
-) -> Option<Frame> {
+/// Finds and decodes a frame's colour image and its optional depth and semantic maps.
+fn decode_frame(files: &FileSet, fs: &FrameSpec) -> DecodedFrame {
     let candidates = paths::image_candidates(&fs.file_path);
     let Some((rgba_path, bytes)) = candidates
         .iter()
         .find_map(|p| files.get(p).map(|b| (p.clone(), b)))
     else {
-        errs.push(DataError::field(
-            file,
-            format!("{}.file_path", fs.field),
-            format!(
-                "refers to {}, which is not in the dataset",
-                candidates.join(" or ")
-            ),
-        ));
-        return None;
+        return DecodedFrame {
+            rgba: Err(candidates),
+            depth: None,
+            parts: None,
+        };
     };
-    let rgba = errs.keep(image_io::decode_rgba(&rgba_path, bytes));
+    let depth = find_sibling(files, &rgba_path, "depth", &[".png"])
+        .map(|(path, b)| (path.clone(), image_io::decode_depth(&path, b)));
+    let parts = find_sibling(files, &rgba_path, "semantic", &[".png", ".npy"]).map(|(path, b)| {
+        let map = if path.ends_with(".npy") {
+            npy::decode_parts_npy(&path, b)
+        } else {
+            image_io::decode_parts_png(&path, b)
+        };
+        (path, map)
+    });
+    DecodedFrame {
+        rgba: Ok((rgba_path.clone(), image_io::decode_rgba(&rgba_path, bytes))),
+        depth: Some(depth),
+        parts: Some(parts),
+    }
+}
+
+/// The optional `kind` file of a frame (`depth`, `semantic`) under the first of `exts` present,
+/// or the path it was expected at.
+fn find_sibling<'a>(
+    files: &'a FileSet,
+    rgba_path: &str,
+    kind: &str,
+    exts: &[&str],
+) -> Result<(String, &'a [u8]), String> {
+    let candidates: Vec<String> = exts
+        .iter()
+        .filter_map(|e| paths::sibling(rgba_path, kind, e))
+        .collect();
+    candidates
+        .iter()
+        .find_map(|p| files.get(p).map(|b| (p.clone(), b.as_slice())))
+        .ok_or_else(|| {
+            candidates
+                .into_iter()
+                .next()
+                .unwrap_or_else(|| rgba_path.to_string())
+        })
+}
+
+/// Records in `checks` whether a frame has its optional map `k` (0 depth, 1 semantic); returns it.
+fn note_sibling<T>(
+    found: Option<Found<T>>,
+    k: usize,
+    checks: &mut SplitChecks,
+) -> Option<(String, Result<T, DataError>)> {
+    match found? {
+        Ok((path, map)) => {
+            checks.present[k].push(path.clone());
+            Some((path, map))
+        }
+        Err(expected) => {
+            checks.missing[k].push(expected);
+            None
+        }
+    }
+}
+
+/// Checks a decoded frame against its transforms entry and its split, and assembles it.
+fn read_frame(
+    file: &str,
+    fs: &FrameSpec,
+    decoded: DecodedFrame,
+    state: State,
+    part_limit: Option<usize>,
+    checks: &mut SplitChecks,
+    errs: &mut Errors,
+) -> Option<Frame> {
+    let (rgba_path, rgba) = match decoded.rgba {
+        Ok(found) => found,
+        Err(candidates) => {
+            errs.push(DataError::field(
+                file,
+                format!("{}.file_path", fs.field),
+                format!(
+                    "refers to {}, which is not in the dataset",
+                    candidates.join(" or ")
+                ),
+            ));
+            return None;
+        }
+    };
+    let rgba = errs.keep(rgba);
 
     // Size agreement: with w/h from the transforms file when given, else with the first image of the split.
     if let Some(img) = &rgba {
@@ -274,8 +330,8 @@ fn read_frame(
         }
     }
 
-    let depth = sibling_file(files, &rgba_path, 0, checks).and_then(|(path, b)| {
-        let d = errs.keep(image_io::decode_depth(&path, b))?;
+    let depth = note_sibling(decoded.depth, 0, checks).and_then(|(path, d)| {
+        let d = errs.keep(d)?;
         if let Some(img) = &rgba
             && (d.width, d.height) != (img.width, img.height)
         {
@@ -291,12 +347,8 @@ fn read_frame(
         Some(d)
     });
 
-    let parts = sibling_file(files, &rgba_path, 1, checks).and_then(|(path, b)| {
-        let m = if path.ends_with(".npy") {
-            errs.keep(npy::decode_parts_npy(&path, b))?
-        } else {
-            errs.keep(image_io::decode_parts_png(&path, b))?
-        };
+    let parts = note_sibling(decoded.parts, 1, checks).and_then(|(path, m)| {
+        let m = errs.keep(m)?;
         if let Some(img) = &rgba
             && (m.width, m.height) != (img.width, img.height)
         {

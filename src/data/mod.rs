@@ -28,6 +28,7 @@ mod gt;
 mod image_io;
 mod json;
 mod npy;
+mod parallel;
 mod paths;
 mod ply;
 mod summary;
