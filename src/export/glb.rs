@@ -14,7 +14,7 @@
 //! - `extras.joint` on a child node: name, type, axis (joint frame), origin (xyz, rpy in the parent
 //!   frame), limits and the start/end values, in URDF units (radians, metres).
 //!
-//! Checked by the Khronos glTF validator in the tests (`tests/export.rs`).
+//! Checked by the Khronos glTF validator in the tests (`tests/native/export.rs`).
 
 use std::collections::HashMap;
 use std::sync::Arc;

@@ -1,9 +1,8 @@
 //! What the page drives, natively on lavapipe: a fit heard, previewed, paused and cancelled
 //! through an [`Observer`], its progress fraction, the fit folder it downloads, and the result
 //! viewer's scene drawn by the renderer.
-#![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use artmesh::data::{Dataset, State};
 use artmesh::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};

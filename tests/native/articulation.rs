@@ -1,8 +1,7 @@
 //! The articulation phase on lavapipe: the motion kernels against the CPU, and the joint-type
 //! bake-off and whole phase on small procedural objects.
-#![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 #[test]
 fn motion_kernels_match_the_cpu() {

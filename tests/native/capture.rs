@@ -2,7 +2,6 @@
 //! datasets the reader accepts, whose ground truth describes exactly the motion between the rendered states and
 //! scores zero when fed back as a prediction; captures are reproducible; objects the part model cannot describe
 //! are refused with clear errors.
-#![cfg(not(target_arch = "wasm32"))]
 
 use std::sync::OnceLock;
 
@@ -23,9 +22,7 @@ fn context() -> &'static GpuContext {
     CTX.get_or_init(|| block_on(GpuContext::new()).expect("a GPU adapter (lavapipe in CI)"))
 }
 
-mod common;
-
-use common::shared_objects as objects;
+use crate::common::shared_objects as objects;
 
 fn small_spec(seed: u64, train_views: usize) -> RenderSpec {
     RenderSpec {

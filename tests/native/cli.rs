@@ -1,5 +1,4 @@
 //! The `artmesh` binary as scripts use it: exit codes, JSON on stdout, errors on stderr.
-#![cfg(not(target_arch = "wasm32"))]
 
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

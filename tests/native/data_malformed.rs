@@ -1,7 +1,6 @@
 //! Malformed datasets: every case of the shared catalogue must produce its specific error (file + field +
 //! message), errors are collected rather than stopping at the first, and nothing panics on broken bytes.
 // Native only: the browser runs the same fixture and catalogue from tests/web.rs.
-#![cfg(not(target_arch = "wasm32"))]
 
 use std::panic::{AssertUnwindSafe, catch_unwind};
 

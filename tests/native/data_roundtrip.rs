@@ -1,6 +1,5 @@
 //! Dataset reader/writer round trips, foreign layouts (ArtGS / MPArt-90 / PARIS), PLY variants and summaries.
 // Native only: the browser runs the same fixture and catalogue from tests/web.rs.
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::data::fixture::{
     self, FixtureParams, artgs_style_files, small_dataset, write_npy_i32, write_npy_i64,

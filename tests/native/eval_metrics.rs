@@ -5,10 +5,8 @@
 //! Tolerances: joint metrics are computed in f64 from f32 inputs, so exact cases are checked to 1e-6 (degrees,
 //! 0.1 m units, metres); Chamfer values built from exactly corresponding samples to 1e-3 of their unit; sampled
 //! Chamfer bounds are derived by hand in each test.
-#![cfg(not(target_arch = "wasm32"))]
 
-mod eval_metrics_common;
-
+use crate::eval_metrics_common::{cuboid, prismatic, revolute};
 use artmesh::data::{GtJoint, JointKind, TriMesh};
 use artmesh::eval::{
     ChamferOptions, EvalOptions, Solver, axis_angle_deg, axis_line_distance, axis_pos,
@@ -17,7 +15,6 @@ use artmesh::eval::{
 };
 use artmesh::mesh::spatial::KdTree;
 use artmesh::rng::Rng;
-use eval_metrics_common::{cuboid, prismatic, revolute};
 use glam::Vec3;
 
 const EPS: f64 = 1e-6;

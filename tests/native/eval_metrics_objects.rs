@@ -1,15 +1,12 @@
 //! Whole-object evaluation tests for `artmesh::eval` (DESIGN.md §7): an object scored against its own
 //! ground truth (also reordered), input errors, and the benchmark tables by part count and category.
-#![cfg(not(target_arch = "wasm32"))]
 
-mod eval_metrics_common;
-
+use crate::eval_metrics_common::{cuboid, prismatic, revolute};
 use artmesh::data::{GtJoint, GtMeshes, TriMesh};
 use artmesh::eval::{
     BenchmarkTable, ChamferOptions, EvalError, EvalOptions, ObjectMetrics, PartBucket,
     chamfer_meshes, evaluate_object,
 };
-use eval_metrics_common::{cuboid, prismatic, revolute};
 use glam::Vec3;
 
 /// Three movable parts (two doors and a drawer) on a box, with their joints.

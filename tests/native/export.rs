@@ -1,9 +1,8 @@
 //! The exports, checked by the programs that consume them: the Khronos glTF validator (npm
 //! `gltf-validator`), MuJoCo and PyBullet (PyPI), and our own URDF reader with the ground-truth
 //! renderer. `scripts/setup.sh` installs the tools; a missing one fails the test and says so.
-#![cfg(not(target_arch = "wasm32"))]
 
-mod common;
+use crate::common;
 
 use std::path::{Path, PathBuf};
 use std::process::Command;

@@ -1,13 +1,10 @@
 //! The photometric driver on lavapipe: a short fit of a procedural object from a jittered copy of
 //! its surface must raise the training PSNR and lower the loss (the rasterizer learns).
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::fit::photometric::{self, PhotometricConfig};
 use artmesh::fixtures::photometric::{SceneSpec, synthetic_scene};
 
-mod common;
-
-use common::context;
+use crate::common::context;
 
 fn run(spec: SceneSpec, config: PhotometricConfig) -> photometric::PhotometricResult {
     let ctx = context();

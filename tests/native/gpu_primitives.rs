@@ -1,12 +1,9 @@
 //! The GPU primitives on the native adapter (lavapipe in CI): prefix sum and radix sort against
 //! CPU results from 1 to 4M elements, the 2-D dispatch tiling path, and limit errors.
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::gpu::{GpuError, PrefixSum, RadixSort, selftest};
 
-mod common;
-
-use common::context;
+use crate::common::context;
 
 fn assert_all_pass(checks: &[selftest::PrimitiveCheck]) {
     let failed: Vec<_> = checks.iter().filter(|c| !c.passed()).collect();

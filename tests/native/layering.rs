@@ -453,7 +453,7 @@ fn faults(tree: &Tree) -> Vec<String> {
     for (from, tos) in &graph {
         let Some(lf) = layer(&top(from)) else {
             faults.push(format!(
-                "src/{from}: module `{}` has no layer in tests/layering.rs",
+                "src/{from}: module `{}` has no layer in tests/native/layering.rs",
                 top(from)
             ));
             continue;

@@ -1,16 +1,13 @@
 //! The GPU image loss, Adam and the FMA probe on the native adapter (lavapipe in CI): loss terms and
 //! gradient against the f64 CPU reference, central finite differences of every term, Adam against a
 //! CPU Adam (decaying lr, remap, reset), target views split over several buffers, input errors.
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::data::{DepthMap, PartMap, RgbaImage};
 use artmesh::gpu::{GpuError, fma_peak};
 use artmesh::loss::{ImageLoss, LossWeights, TargetImages, TargetView, check, render_channels};
 use artmesh::optim::{Adam, AdamConfig, ExponentialDecay, check as adam_check};
 
-mod common;
-
-use common::context;
+use crate::common::context;
 
 /// 23×17: no dimension or pixel count is a multiple of the 256-invocation workgroup.
 const W: u32 = 23;

@@ -2,16 +2,13 @@
 //! cabinet): structure, parts, meshes, forward kinematics, `package://` resolution and the URDF writer round
 //! trip. Bad input (malformed URDFs, bad mesh references, limits, corrupt mesh files) is in
 //! `object_import_errors.rs`.
-#![cfg(not(target_arch = "wasm32"))]
 
 use std::f32::consts::FRAC_PI_2;
 
 use artmesh::object::{ArticulatedObject, Geometry, JointKind};
 use glam::{Quat, Vec3};
 
-mod common;
-
-use common::shared_objects as objects;
+use crate::common::shared_objects as objects;
 
 fn import(path: &str) -> ArticulatedObject {
     ArticulatedObject::from_urdf(path, objects()).unwrap_or_else(|e| panic!("{path}: {e}"))

@@ -1,13 +1,10 @@
 //! URDF import of bad input, starting from the real objects in `../shared/objects/`: a malformed URDF, bad
 //! mesh references, joint-limit rules, and corrupt mesh files (errors or meshes, never panics).
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::data::FileSet;
 use artmesh::object::{ArticulatedObject, JointKind};
 
-mod common;
-
-use common::shared_objects as objects;
+use crate::common::shared_objects as objects;
 
 /// A copy of the objects with `path` edited by `edit` (text replacement in a URDF).
 fn edited(path: &str, from: &str, to: &str) -> FileSet {

@@ -1,13 +1,10 @@
 //! The differentiable rasterizer on the native adapter (lavapipe in CI): forward pass against the
 //! CPU reference renderer, backward pass against central finite differences for every parameter
 //! group, and buffer limits that give clear errors.
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::raster::check;
 
-mod common;
-
-use common::context;
+use crate::common::context;
 
 #[test]
 fn forward_matches_cpu_reference() {

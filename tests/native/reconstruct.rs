@@ -1,16 +1,13 @@
 //! The reconstruction phase on lavapipe: a `tiny` reconstruction of a 2-part object gives one
 //! mesh per part per state with no cross-part face, near its ground truth; the global-remeshing
 //! ablation builds faces across parts and the report counts them.
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::eval::mesh_quality::reconstruction_failures;
 use artmesh::fit::reconstruct::RemeshMode;
 use artmesh::fixtures::object::tiny_reconstruction;
 use artmesh::mesh::topology::cross_part_faces;
 
-mod common;
-
-use common::context;
+use crate::common::context;
 
 #[test]
 fn a_tiny_two_part_reconstruction_is_part_aware_and_near_the_ground_truth() {

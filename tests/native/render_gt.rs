@@ -1,6 +1,5 @@
 //! Ground-truth renderer against analytic references: box depth by ray casting, part ids of two boxes,
 //! projection agreement with `Camera::project`, determinism, and the real Sektion cabinet at two states.
-#![cfg(not(target_arch = "wasm32"))]
 
 use std::path::Path;
 

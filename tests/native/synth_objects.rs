@@ -1,6 +1,5 @@
 //! Procedural objects of every category: structure checks for every part count, reproducibility, and a
 //! contact sheet (`artefacts/synth-contact-sheet.png`) of one object per category at both states.
-#![cfg(not(target_arch = "wasm32"))]
 
 use artmesh::data::encode_png;
 use artmesh::gpu::GpuContext;

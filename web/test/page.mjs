@@ -178,7 +178,7 @@ try {
     // since the axis registration, 0.28° of motion on 2026-12-02; 0.84° before it), asserted here;
     // at tiny (32 px, 4 views) they do not (natively, a 1e-6 change of the reconstruction's SSIM
     // weight moves the tiny axis up to 2.3°), so tiny asserts its accuracy bound against the
-    // ground truth (< 10°, tests/articulation.rs) and prints the gap against the target.
+    // ground truth (< 10°, tests/native/articulation.rs) and prints the gap against the target.
     const [angleTol, mmTol, motionTol] = parityPreset === "tiny" ? [10, 0.02, [10, 0.02]] : [0.5, 0.005, [0.5, 0.005]];
     for (let i = 0; i < nj.length; i++) {
       const a = nj[i], b = pj[i];

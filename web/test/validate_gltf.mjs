@@ -1,6 +1,6 @@
 // Runs the Khronos glTF validator (npm gltf-validator) on each GLB given and prints one JSON line per
 // file: {"file", "errors", "warnings", "infos", "messages": [first 20 errors/warnings]}.
-// Exit status 0 only when no file has an error. Used by the native export tests (tests/export.rs).
+// Exit status 0 only when no file has an error. Used by the native export tests (tests/native/export.rs).
 import { readFile } from "node:fs/promises";
 import validator from "gltf-validator";
 

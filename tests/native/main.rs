@@ -1,0 +1,27 @@
+//! The native integration tests, one module per concern, in one test binary: one link instead of
+//! nineteen, and one harness whose threads stay busy across modules (`cargo test --test native
+//! raster::` runs one module). The browser's tests are `tests/web.rs`.
+#![cfg(not(target_arch = "wasm32"))]
+
+mod common;
+mod eval_metrics_common;
+
+mod app;
+mod articulation;
+mod capture;
+mod cli;
+mod data_malformed;
+mod data_roundtrip;
+mod eval_metrics;
+mod eval_metrics_objects;
+mod export;
+mod fit_photometric;
+mod gpu_primitives;
+mod layering;
+mod loss_optim;
+mod object_import;
+mod object_import_errors;
+mod raster;
+mod reconstruct;
+mod render_gt;
+mod synth_objects;
