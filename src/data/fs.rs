@@ -115,7 +115,8 @@ pub fn write_dir(files: &FileSet, root: &Path) -> Result<(), DataError> {
                 "expected a relative path inside the output folder",
             ));
         }
-        if root.join(rel).exists() {
+        // A dangling symlink counts: `exists()` would follow it and say no.
+        if fs::symlink_metadata(root.join(rel)).is_ok() {
             return Err(DataError::file(
                 rel,
                 format!(

@@ -6,27 +6,27 @@ use std::process::{Command, Output};
 use artmesh::data::{self, GroundTruth};
 use glam::Quat;
 
-fn artmesh(args: &[&str]) -> Output {
+pub(crate) fn artmesh(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_artmesh"))
         .args(args)
         .output()
         .expect("the artmesh binary runs")
 }
 
-fn text(bytes: &[u8]) -> String {
+pub(crate) fn text(bytes: &[u8]) -> String {
     String::from_utf8_lossy(bytes).into_owned()
 }
 
 /// A fresh folder under the system temp dir, removed when dropped.
-struct TempDir(PathBuf);
+pub(crate) struct TempDir(pub(crate) PathBuf);
 
 impl TempDir {
-    fn new(name: &str) -> Self {
+    pub(crate) fn new(name: &str) -> Self {
         let dir = std::env::temp_dir().join(format!("artmesh-cli-{name}-{}", std::process::id()));
         let _ = std::fs::remove_dir_all(&dir);
         Self(dir)
     }
-    fn join(&self, p: &str) -> String {
+    pub(crate) fn join(&self, p: &str) -> String {
         self.0.join(p).display().to_string()
     }
 }
@@ -62,7 +62,7 @@ fn sample_then_info_then_refuse_to_overwrite() {
     let again = artmesh(&["sample", "--out", &dir]);
     assert_eq!(again.status.code(), Some(1));
     assert!(
-        text(&again.stderr).contains("refusing to overwrite"),
+        text(&again.stderr).contains("already exists and is not empty"),
         "{}",
         text(&again.stderr)
     );
@@ -139,7 +139,7 @@ fn tree(root: &str) -> data::FileSet {
 }
 
 /// `args` followed by capture options for tiny, fast datasets.
-fn with_small_capture<'a>(args: &[&'a str], test_views: &'a str) -> Vec<&'a str> {
+pub(crate) fn with_small_capture<'a>(args: &[&'a str], test_views: &'a str) -> Vec<&'a str> {
     let mut all = args.to_vec();
     all.extend([
         "--width",

@@ -21,6 +21,7 @@ mod layering;
 mod loss_optim;
 mod object_import;
 mod object_import_errors;
+mod outputs;
 mod raster;
 mod reconstruct;
 mod render_gt;

@@ -42,35 +42,40 @@ pub struct CaptureArgs {
     /// Horizontal field of view in degrees.
     #[arg(long, default_value_t = 39.6)]
     fov: f32,
-    /// Start state: interval of each joint's normalised range to draw from.
-    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [0.6f32, 0.8])]
-    start_range: Vec<f32>,
-    /// End state: interval of each joint's normalised range to draw from.
-    #[arg(long, value_delimiter = ',', num_args = 2, default_values_t = [0.2f32, 0.4])]
-    end_range: Vec<f32>,
+    /// Start state: interval of each joint's normalised range to draw from, as `LOW,HIGH`.
+    #[arg(long, value_parser = interval, default_value = "0.6,0.8")]
+    start_range: (f32, f32),
+    /// End state: interval of each joint's normalised range to draw from, as `LOW,HIGH`.
+    #[arg(long, value_parser = interval, default_value = "0.2,0.4")]
+    end_range: (f32, f32),
     /// Cameras on the whole sphere instead of the upper hemisphere.
     #[arg(long)]
     sphere: bool,
+}
+
+/// Parses `LOW,HIGH` (two numbers, comma-separated); whether it lies in [0, 1] is the capture's check.
+fn interval(text: &str) -> Result<(f32, f32), String> {
+    let parse = |v: &str| v.trim().parse::<f32>().map_err(|e| format!("'{v}': {e}"));
+    match text.split(',').collect::<Vec<_>>()[..] {
+        [lo, hi] => Ok((parse(lo)?, parse(hi)?)),
+        _ => Err(format!(
+            "expected two numbers as LOW,HIGH (e.g. 0.6,0.8), found '{text}'"
+        )),
+    }
 }
 
 impl CaptureArgs {
     /// The capture these options ask for (quick: the quick suite's defaults), drawn with `seed`.
     pub fn spec(&self, quick: bool, seed: u64) -> RenderSpec {
         let (size, train, test) = if quick { (64, 6, 2) } else { (800, 100, 20) };
-        let pair = |v: &[f32]| {
-            (
-                v.first().copied().unwrap_or(0.0),
-                v.get(1).copied().unwrap_or(0.0),
-            )
-        };
         RenderSpec {
             width: self.width.unwrap_or(size),
             height: self.height.unwrap_or(size),
             train_views: self.train_views.map_or(train, |v| v as usize),
             test_views: self.test_views.map_or(test, |v| v as usize),
             fov_x: self.fov.to_radians(),
-            start_range: pair(&self.start_range),
-            end_range: pair(&self.end_range),
+            start_range: self.start_range,
+            end_range: self.end_range,
             upper_hemisphere: !self.sphere,
             seed,
         }

@@ -1,5 +1,5 @@
 //! What `artmesh synth`, `render` and `suite` share: objects in, two-state datasets out, written as
-//! they are rendered; fresh folders and files only.
+//! they are rendered (into folders `output::NewFolder` makes).
 
 use std::io::{IsTerminal, Write as _};
 use std::path::{Path, PathBuf};
@@ -9,30 +9,6 @@ use artmesh::export::write_urdf;
 use artmesh::gpu::GpuContext;
 use artmesh::object::ArticulatedObject;
 use artmesh::render::{RenderProgress, RenderSpec, RenderedDataset, render_dataset};
-
-/// Refuses an existing non-empty folder: generated files never mix with (or overwrite) the user's.
-pub fn fresh_folder(out: &Path) -> Result<(), String> {
-    match std::fs::read_dir(out).map(|mut entries| entries.next().is_some()) {
-        Ok(true) => Err(format!(
-            "{} already exists and is not empty; choose a new folder",
-            out.display()
-        )),
-        Ok(false) => Ok(()),
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => Ok(()),
-        Err(e) => Err(format!("{}: {e}", out.display())),
-    }
-}
-
-/// Refuses an existing file: outputs never overwrite the user's files.
-pub fn fresh_file(path: &Path) -> Result<(), String> {
-    if path.exists() {
-        return Err(format!(
-            "{} already exists; choose a new file",
-            path.display()
-        ));
-    }
-    Ok(())
-}
 
 /// Writes `object` as `<name>.urdf` + `meshes/` below `folder`.
 pub fn write_object(object: &ArticulatedObject, folder: &Path) -> Result<(), String> {

@@ -7,8 +7,8 @@ use artmesh::pipeline::{self, demo};
 use artmesh::synth::Category;
 
 use crate::args::{BudgetArgs, context, to_json};
-use crate::capture;
 use crate::fit::fit_and_write;
+use crate::output::NewFolder;
 
 /// `artmesh demo`'s arguments.
 #[derive(clap::Args)]
@@ -35,10 +35,7 @@ pub struct DemoArgs {
 /// `artmesh demo`: OUT/dataset (the capture) and OUT/fit (what `fit` writes); prints the report.
 pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
     let out = match args.out {
-        Some(out) => {
-            capture::fresh_folder(&out)?;
-            out
-        }
+        Some(out) => out,
         None => (1..)
             .map(|i| {
                 PathBuf::from(if i == 1 {
@@ -47,7 +44,7 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
                     format!("artmesh-demo-{i}")
                 })
             })
-            .find(|p| !p.exists())
+            .find(|p| std::fs::symlink_metadata(p).is_err())
             .expect("some folder name is free"),
     };
     let (parts, seed) = (args.parts, args.seed);
@@ -57,6 +54,7 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
     let config = args.budget.fit_config(&args.preset)?;
     let spec = config.full_demo_capture(seed);
     let (size, views) = (spec.width, spec.train_views);
+    let folder = NewFolder::create(&out)?;
     let ctx = context()?;
     eprintln!(
         "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state",
@@ -70,8 +68,15 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
         &mut |_| {},
     ))
     .map_err(|e| e.to_string())?;
-    pipeline::write_dataset(&input.dataset, &out.join("dataset")).map_err(|e| e.to_string())?;
-    let report = fit_and_write(&input, &config, &out.join("fit"))?;
+    let dataset = folder.path().join("dataset");
+    pipeline::write_dataset(&input.dataset, &dataset).map_err(|e| e.to_string())?;
+    let report = fit_and_write(
+        &input,
+        &config,
+        &folder.path().join("fit"),
+        &out.join("fit"),
+    )?;
+    folder.finish()?;
     out!("{}", to_json(&report)?);
     eprintln!(
         "demo: dataset in {0}/dataset, fit in {0}/fit",

@@ -7,7 +7,7 @@ use artmesh::data;
 use artmesh::export::{JOINTS_FILE, URDF_FILE, end_configuration, export_twin};
 use artmesh::object::ArticulatedObject;
 
-use crate::capture;
+use crate::output::{check_distinct, check_new_file, write_new_file};
 
 /// `artmesh export`'s arguments.
 #[derive(clap::Args)]
@@ -32,8 +32,10 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode, String> {
     if glb.is_none() && urdf_zip.is_none() {
         return Err("export: say what to write: --glb FILE and/or --urdf-zip FILE".into());
     }
-    for path in glb.iter().chain(urdf_zip) {
-        capture::fresh_file(path)?;
+    let outputs: Vec<&std::path::Path> = glb.iter().chain(urdf_zip).map(|p| p.as_path()).collect();
+    check_distinct(&outputs)?;
+    for path in &outputs {
+        check_new_file(path)?;
     }
     let files = data::read_dir(fit_dir).map_err(|e| e.to_string())?;
     let shown = |rel: &str| fit_dir.join(rel).display().to_string();
@@ -55,8 +57,7 @@ pub fn run(args: &ExportArgs) -> Result<ExitCode, String> {
     let exports = export_twin(&object, &end, joints).map_err(|e| e.to_string())?;
     for (path, bytes) in [(glb, &exports.glb), (urdf_zip, &exports.zip)] {
         if let Some(path) = path {
-            std::fs::write(path, bytes)
-                .map_err(|e| format!("{}: cannot write: {e}", path.display()))?;
+            write_new_file(path, bytes)?;
             eprintln!("export: wrote {} ({} bytes)", path.display(), bytes.len());
         }
     }

@@ -13,7 +13,8 @@ use artmesh::fit::reconstruct::RemeshMode;
 use artmesh::pipeline::{self, FitInput};
 
 use crate::args::{BudgetArgs, context, to_json};
-use crate::{capture, progress};
+use crate::output::NewFolder;
+use crate::progress;
 
 /// `artmesh fit`'s arguments.
 #[derive(clap::Args)]
@@ -51,19 +52,22 @@ pub fn run(args: FitArgs) -> Result<ExitCode, String> {
     if let Some(g) = args.geometry {
         config.articulation.geometry = GeometryUse::parse(&g).map_err(|e| e.to_string())?;
     }
-    capture::fresh_folder(&args.out)?;
+    let folder = NewFolder::create(&args.out)?;
     let input = pipeline::read_dataset(&args.dataset).map_err(|e| e.to_string())?;
-    let report = fit_and_write(&input, &config, &args.out)?;
+    let report = fit_and_write(&input, &config, folder.path(), &args.out)?;
+    folder.finish()?;
     out!("{}", to_json(&report)?);
     Ok(ExitCode::SUCCESS)
 }
 
 /// Fits `dataset` with a progress bar on stderr, writes joints.json, gt/ and report.json
-/// under `out` (a fresh folder), prints the joints and metrics, and returns the report.
+/// under `out` (a fresh folder, which will be `shown` when the command finishes), prints the
+/// joints and metrics, and returns the report.
 pub fn fit_and_write(
     input: &FitInput,
     config: &FitConfig,
     out: &Path,
+    shown: &Path,
 ) -> Result<serde_json::Value, String> {
     let ctx = context()?;
     let mut bar = progress::Bar::new("fit");
@@ -88,7 +92,7 @@ pub fn fit_and_write(
         artmesh::export::URDF_FILE,
         artmesh::export::GLB_FILE,
         artmesh::export::ZIP_FILE,
-        out.display()
+        shown.display()
     );
     Ok(folder.report)
 }

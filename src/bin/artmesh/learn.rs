@@ -7,6 +7,7 @@ use artmesh::fit::photometric::{self, PhotometricConfig};
 use artmesh::fixtures::photometric::{SceneSpec, synthetic_scene};
 
 use crate::args::{context, to_json};
+use crate::output::{check_new_file, write_new_file};
 
 /// `artmesh learn`'s arguments.
 #[derive(clap::Args)]
@@ -50,13 +51,8 @@ pub fn run(args: &LearnArgs) -> Result<ExitCode, String> {
         preview,
     } = args;
     let (size, views, iterations) = (*size, *views, *iterations);
-    if let Some(path) = preview
-        && path.exists()
-    {
-        return Err(format!(
-            "{}: already exists; nothing is overwritten",
-            path.display()
-        ));
+    if let Some(path) = preview {
+        check_new_file(path)?;
     }
     let spec = SceneSpec {
         category: artmesh::synth::Category::parse(category).map_err(|e| e.to_string())?,
@@ -105,7 +101,7 @@ pub fn run(args: &LearnArgs) -> Result<ExitCode, String> {
         let name = path.display().to_string();
         let png = artmesh::data::encode_png(&name, w, h, artmesh::data::PngPixels::Rgb8(&rgb))
             .map_err(|e| e.to_string())?;
-        std::fs::write(path, png).map_err(|e| format!("{name}: {e}"))?;
+        write_new_file(path, &png)?;
         eprintln!("learn: preview (target | start | fitted) in {name}");
     }
     let report = serde_json::json!({

@@ -35,6 +35,8 @@ mod info;
 #[cfg(not(target_arch = "wasm32"))]
 mod learn;
 #[cfg(not(target_arch = "wasm32"))]
+mod output;
+#[cfg(not(target_arch = "wasm32"))]
 mod progress;
 #[cfg(not(target_arch = "wasm32"))]
 mod reconstruct;

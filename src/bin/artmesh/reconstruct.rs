@@ -9,7 +9,8 @@ use artmesh::fit::observer::Progress;
 use artmesh::fit::reconstruct::ReconstructionConfig;
 
 use crate::args::{context, reconstruction_config, to_json};
-use crate::{capture, progress};
+use crate::output::NewFolder;
+use crate::progress;
 
 /// `artmesh reconstruct`'s arguments.
 #[derive(clap::Args)]
@@ -45,8 +46,10 @@ pub fn run(args: &ReconstructArgs) -> Result<ExitCode, String> {
     }
     config.max_size = args.max_size.unwrap_or(config.max_size);
     config.max_views = args.max_views.unwrap_or(config.max_views);
-    capture::fresh_folder(&args.out)?;
-    let report = reconstruct(&args.dataset, &args.out, &config)?;
+    let folder = NewFolder::create(&args.out)?;
+    let report = reconstruct(&args.dataset, folder.path(), &config)?;
+    let out = folder.finish()?;
+    eprintln!("reconstruct: in {}", out.display());
     out!("{}", to_json(&report)?);
     Ok(ExitCode::SUCCESS)
 }

@@ -11,7 +11,8 @@ use artmesh::synth::{SuiteEntry, SuiteKind, generate};
 use serde::Serialize;
 
 use crate::args::{CaptureArgs, context};
-use crate::capture::{dataset, fresh_folder, write_object};
+use crate::capture::{dataset, write_object};
+use crate::output::NewFolder;
 
 /// `artmesh suite`'s arguments.
 #[derive(clap::Args)]
@@ -38,8 +39,11 @@ pub fn run(args: &SuiteArgs) -> Result<ExitCode, String> {
         (_, true) => SuiteKind::Holdout,
         _ => SuiteKind::Full,
     };
+    let folder = NewFolder::create(&args.out)?;
     let ctx = context()?;
-    suite(&ctx, &args.out, kind, &args.capture)?;
+    suite(&ctx, folder.path(), kind, &args.capture)?;
+    let out = folder.finish()?;
+    eprintln!("suite: in {}", out.display());
     Ok(ExitCode::SUCCESS)
 }
 
@@ -74,14 +78,13 @@ struct ManifestEntry<'a> {
 }
 
 /// Every planned object into `out/<id>/` (dataset + `object/`), then `suite.json` and
-/// `contact-sheet.png`.
+/// `contact-sheet.png`; `out` is a new folder.
 fn suite(
     ctx: &GpuContext,
     out: &Path,
     kind: SuiteKind,
     capture: &CaptureArgs,
 ) -> Result<(), String> {
-    fresh_folder(out)?;
     let quick = kind == SuiteKind::Quick;
     let plan = kind.plan();
     let mut objects = Vec::with_capacity(plan.len());
@@ -191,6 +194,21 @@ pub fn read_suite_listing(dir: &Path) -> Result<SuiteListing, String> {
             path.display()
         )
     })?;
+    // An id names a folder inside the suite: never an absolute path, `..` or a nested path.
+    for (i, o) in manifest.objects.iter().enumerate() {
+        let mut parts = Path::new(&o.id).components();
+        let plain = matches!(
+            (parts.next(), parts.next()),
+            (Some(std::path::Component::Normal(_)), None)
+        );
+        if !plain || o.id.contains('\\') {
+            return Err(format!(
+                "{}: objects[{i}].id {:?} is not a folder name inside the suite (no '/', '\\' or '..')",
+                path.display(),
+                o.id.chars().take(80).collect::<String>()
+            ));
+        }
+    }
     Ok(SuiteListing {
         objects: manifest
             .objects

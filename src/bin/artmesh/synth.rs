@@ -8,6 +8,7 @@ use artmesh::synth::{Category, SynthParams, generate};
 
 use crate::args::{CaptureArgs, context};
 use crate::capture;
+use crate::output::NewFolder;
 
 /// `artmesh synth`'s arguments.
 #[derive(clap::Args)]
@@ -58,13 +59,14 @@ pub fn synth(args: SynthArgs) -> Result<ExitCode, String> {
         seed: args.seed,
     };
     let object = generate(&params).map_err(|e| e.to_string())?;
-    let out = &args.out;
-    capture::fresh_folder(out)?;
-    capture::write_object(&object, &out.join("object"))?;
+    let folder = NewFolder::create(&args.out)?;
+    capture::write_object(&object, &folder.path().join("object"))?;
     if !args.object_only {
         let ctx = context()?;
-        capture::dataset(&ctx, &object, &args.capture.spec(false, args.seed), out)?;
+        let spec = args.capture.spec(false, args.seed);
+        capture::dataset(&ctx, &object, &spec, folder.path())?;
     }
+    let out = folder.finish()?;
     out!("wrote {} to {}", object.name, out.display());
     Ok(ExitCode::SUCCESS)
 }
@@ -72,14 +74,11 @@ pub fn synth(args: SynthArgs) -> Result<ExitCode, String> {
 /// `artmesh render`: a URDF object's dataset.
 pub fn render(args: RenderArgs) -> Result<ExitCode, String> {
     let object = capture::read_urdf(&args.urdf)?;
-    capture::fresh_folder(&args.out)?;
+    let folder = NewFolder::create(&args.out)?;
     let ctx = context()?;
-    capture::dataset(
-        &ctx,
-        &object,
-        &args.capture.spec(false, args.seed),
-        &args.out,
-    )?;
-    out!("wrote {} to {}", object.name, args.out.display());
+    let spec = args.capture.spec(false, args.seed);
+    capture::dataset(&ctx, &object, &spec, folder.path())?;
+    let out = folder.finish()?;
+    out!("wrote {} to {}", object.name, out.display());
     Ok(ExitCode::SUCCESS)
 }

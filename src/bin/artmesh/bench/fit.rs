@@ -18,7 +18,7 @@ use serde::Serialize;
 
 use super::source::{SourceObject, SuiteSource};
 use crate::args::{SuiteObjects, context, fit_config, to_json};
-use crate::capture::fresh_file;
+use crate::output::{check_new_file, write_new_file};
 use crate::suite::CaptureSettings;
 
 /// `artmesh bench fit`'s arguments.
@@ -73,7 +73,7 @@ pub fn run(args: &FitBenchArgs) -> Result<String, String> {
         config.articulation.geometry = GeometryUse::parse(g).map_err(|e| e.to_string())?;
     }
     if let Some(path) = &args.markdown {
-        fresh_file(path)?;
+        check_new_file(path)?;
     }
     let ctx = context()?;
     let source = match &args.suite_dir {
@@ -100,7 +100,7 @@ pub fn run(args: &FitBenchArgs) -> Result<String, String> {
     let md = report.to_markdown();
     eprintln!("{md}");
     if let Some(path) = &args.markdown {
-        std::fs::write(path, md).map_err(|e| format!("{}: {e}", path.display()))?;
+        write_new_file(path, md.as_bytes())?;
     }
     to_json(&report)
 }
