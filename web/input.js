@@ -45,11 +45,12 @@ function status(text) {
 }
 
 function problems(message) {
+  // The message counts its problems itself (and lists at most 50 of them).
   const lines = message.split("\n").filter((l) => l.trim() !== "");
   const out = $("dataset-result");
   out.hidden = false;
   out.className = "fail";
-  out.textContent = `The dataset cannot be used: ${lines.length} problem(s) found.\n` + lines.join("\n");
+  out.textContent = "The dataset cannot be used: " + lines.join("\n");
   $("thumbs").hidden = true;
   $("fit-controls").hidden = true;
   document.body.dataset.dataset = "problems";

@@ -37,12 +37,38 @@ impl DataError {
     }
 }
 
+/// Longest file name, field or message shown (in characters); the rest is counted.
+const MAX_SHOWN_CHARS: usize = 400;
+
+/// Most errors a [`DatasetErrors`] lists; the rest are counted.
+pub(crate) const MAX_SHOWN_ERRORS: usize = 50;
+
+/// `text` as it may go to a terminal or a page: control characters (from file names, say)
+/// escaped, at most [`MAX_SHOWN_CHARS`] characters and a count of the rest.
+fn shown(text: &str, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+    let mut chars = text.chars();
+    for c in chars.by_ref().take(MAX_SHOWN_CHARS) {
+        if c.is_control() {
+            write!(f, "{}", c.escape_default())?;
+        } else {
+            write!(f, "{c}")?;
+        }
+    }
+    match chars.count() {
+        0 => Ok(()),
+        more => write!(f, "… ({more} more characters)"),
+    }
+}
+
 impl fmt::Display for DataError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        match &self.field {
-            Some(field) => write!(f, "{}: {}: {}", self.file, field, self.message),
-            None => write!(f, "{}: {}", self.file, self.message),
+        shown(&self.file, f)?;
+        if let Some(field) = &self.field {
+            f.write_str(": ")?;
+            shown(field, f)?;
         }
+        f.write_str(": ")?;
+        shown(&self.message, f)
     }
 }
 
@@ -60,12 +86,21 @@ impl DatasetErrors {
 }
 
 impl fmt::Display for DatasetErrors {
+    /// The first [`MAX_SHOWN_ERRORS`] errors, a line each, then how many more there are.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        for (i, e) in self.0.iter().enumerate() {
+        for (i, e) in self.0.iter().take(MAX_SHOWN_ERRORS).enumerate() {
             if i > 0 {
                 writeln!(f)?;
             }
             write!(f, "{e}")?;
+        }
+        if let Some(more) = self
+            .0
+            .len()
+            .checked_sub(MAX_SHOWN_ERRORS)
+            .filter(|&n| n > 0)
+        {
+            write!(f, "\n… and {more} more problems")?;
         }
         Ok(())
     }
@@ -110,5 +145,30 @@ impl Errors {
         } else {
             Err(DatasetErrors(self.0))
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn errors_are_shown_escaped_short_and_capped() {
+        let e = DataError::field("rgba/\u{1b}[31mred\n.png", "size", "x".repeat(1000));
+        let shown = e.to_string();
+        assert!(
+            shown.starts_with("rgba/\\u{1b}[31mred\\n.png: size: xxx"),
+            "{shown}"
+        );
+        assert!(shown.ends_with("… (600 more characters)"), "{shown}");
+        assert!(!shown.chars().any(char::is_control));
+        let many = DatasetErrors(
+            (0..200)
+                .map(|i| DataError::file(format!("{i}.png"), "bad"))
+                .collect(),
+        );
+        let text = many.to_string();
+        assert_eq!(text.lines().count(), MAX_SHOWN_ERRORS + 1);
+        assert!(text.ends_with("… and 150 more problems"), "{text}");
     }
 }

@@ -8,7 +8,7 @@ use js_sys::{Array, Function, Object, Reflect, Uint8ClampedArray};
 use wasm_bindgen::prelude::*;
 
 use super::{budget, context, js_error};
-use crate::data::{Dataset, FileSet, Split, State, read_zip, rebase_on_dataset_root};
+use crate::data::{FileSet, Split, State, read_zip, rebase_on_dataset_root};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
 use crate::fit::observer::Progress;
@@ -90,15 +90,9 @@ pub fn catalogue() -> String {
 pub struct WebDataset(Rc<FitInput>);
 
 fn dataset_from(files: &FileSet, name: String) -> Result<WebDataset, JsError> {
-    let dataset = Dataset::from_files(files).map_err(|problems| {
-        let lines: Vec<String> = problems.0.iter().map(ToString::to_string).collect();
-        JsError::new(&format!(
-            "{} problem(s) found:\n{}",
-            lines.len(),
-            lines.join("\n")
-        ))
-    })?;
-    Ok(WebDataset(Rc::new(FitInput::user(dataset, name))))
+    let input =
+        pipeline::dataset_from_files(files, name).map_err(|e| JsError::new(&e.to_string()))?;
+    Ok(WebDataset(Rc::new(input)))
 }
 
 #[wasm_bindgen(js_class = Dataset)]

@@ -135,3 +135,37 @@ fn eval_reads_only_folders_inside_the_suite() {
         refused(&["eval", &s, &s], "is not a folder name inside the suite");
     }
 }
+
+#[test]
+fn info_and_fit_name_what_a_fit_would_refuse() {
+    let tmp = TempDir::new("outputs-refuse");
+    let dir = tmp.join("bg");
+    let run = artmesh(&["sample", "--out", &dir, "--views", "2"]);
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    // Every semantic map background: the depth is fine, the part maps are at fault.
+    for state in ["start", "end"] {
+        for split in ["train", "test"] {
+            let folder = Path::new(&dir).join(format!("{state}/{split}/semantic"));
+            for entry in std::fs::read_dir(folder).unwrap() {
+                let path = entry.unwrap().path();
+                let (w, h) = image::image_dimensions(&path).unwrap();
+                let zeros = vec![0u16; (w * h) as usize];
+                let name = path.display().to_string();
+                let png = artmesh::data::encode_png(
+                    &name,
+                    w,
+                    h,
+                    artmesh::data::PngPixels::Gray16(&zeros),
+                );
+                std::fs::write(&path, png.unwrap()).unwrap();
+            }
+        }
+    }
+    let says = "start/train: every semantic map is background";
+    refused(&["info", &dir], says);
+    refused(
+        &["fit", &dir, "--preset", "tiny", "--out", &tmp.join("fit")],
+        says,
+    );
+    assert!(!Path::new(&tmp.join("fit")).exists());
+}

@@ -7,6 +7,7 @@ use artmesh::data::{self, Dataset, fixture};
 use artmesh::gpu::selftest;
 
 use crate::args::{context, to_json};
+use crate::output::NewFolder;
 
 /// `artmesh info`'s arguments.
 #[derive(clap::Args)]
@@ -55,6 +56,16 @@ pub fn info(args: &InfoArgs) -> Result<ExitCode, String> {
     let files = data::read_dir(root).map_err(|e| e.to_string())?;
     match Dataset::from_files(&files) {
         Ok(dataset) => {
+            let problems = artmesh::pipeline::check::fit_problems(&dataset);
+            if !problems.is_empty() {
+                eprintln!(
+                    "{}: the dataset reads, but a fit would stop on {} problem(s):",
+                    root.display(),
+                    problems.len()
+                );
+                eprintln!("{}", problems.join("\n"));
+                return Ok(ExitCode::FAILURE);
+            }
             let summary = dataset.summary();
             if args.json {
                 out!("{}", to_json(&summary)?);
@@ -126,7 +137,9 @@ pub fn sample(args: &SampleArgs) -> Result<ExitCode, String> {
     let files = fixture::small_dataset(params)
         .to_files()
         .map_err(|e| e.to_string())?;
-    data::write_dir(&files, &args.out).map_err(|e| e.to_string())?;
-    out!("wrote {} files to {}", files.len(), args.out.display());
+    let folder = NewFolder::create(&args.out)?;
+    data::write_dir(&files, folder.path()).map_err(|e| e.to_string())?;
+    let out = folder.finish()?;
+    out!("wrote {} files to {}", files.len(), out.display());
     Ok(ExitCode::SUCCESS)
 }
