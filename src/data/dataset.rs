@@ -201,6 +201,39 @@ fn read_view_set(
     })
 }
 
+/// Every path the transforms files in `files` refer to, with each image's depth and semantic
+/// siblings under every name the reader tries: what a reader of a folder needs to read besides
+/// the transforms files and `gt/`. Malformed transforms files contribute what they can; their
+/// errors are the reader's to report.
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) fn referenced_paths(files: &FileSet) -> BTreeSet<String> {
+    let mut wanted = BTreeSet::new();
+    for state in State::ALL {
+        for split in Split::ALL {
+            let file = transforms_file_name(split, state);
+            let Some(bytes) = files.get(&file) else {
+                continue;
+            };
+            let Some(spec) = transforms::parse(&file, bytes, &mut Errors::default()) else {
+                continue;
+            };
+            for fs in &spec.frames {
+                for image in paths::image_candidates(&fs.file_path) {
+                    for (kind, ext) in [
+                        ("depth", ".png"),
+                        ("semantic", ".png"),
+                        ("semantic", ".npy"),
+                    ] {
+                        wanted.extend(paths::sibling(&image, kind, ext));
+                    }
+                    wanted.insert(image);
+                }
+            }
+        }
+    }
+    wanted
+}
+
 /// A found-and-decoded optional file of a frame (its path and decoding, each `Err` naming the
 /// file), or the path it was expected at.
 type Found<T> = Result<(String, Result<T, DataError>), String>;

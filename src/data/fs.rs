@@ -23,14 +23,98 @@ pub enum ReadDatasetError {
     },
 }
 
-/// Reads the dataset folder `root` (see [`read_dir`]) and validates it; every problem found is
-/// listed in the error, after the folder's name.
+/// Reads the dataset folder `root` (see [`read_dataset_files`]) and validates it; every problem
+/// found is listed in the error, after the folder's name.
 pub fn read_dataset(root: &Path) -> Result<super::Dataset, ReadDatasetError> {
-    let files = read_dir(root)?;
+    let files = read_dataset_files(root)?;
     super::Dataset::from_files(&files).map_err(|errors| ReadDatasetError::Invalid {
         root: root.display().to_string(),
         errors,
     })
+}
+
+/// The files of the dataset folder `root` that a dataset is made of, and nothing else: the
+/// transforms files, `gt/`, and the images the transforms files refer to (with their depth and
+/// semantic siblings). An unrelated video beside the frames, a name that is not UTF-8 or a
+/// dangling symlink elsewhere in the folder is never read and never an error.
+pub fn read_dataset_files(root: &Path) -> Result<FileSet, DataError> {
+    let mut listing = std::collections::BTreeMap::new();
+    list(&folder(root)?, "", 0, &mut listing)?;
+    let read = |rel: &str, path: &Path, files: &mut FileSet| -> Result<(), DataError> {
+        let bytes =
+            fs::read(path).map_err(|e| DataError::file(rel, format!("cannot read: {e}")))?;
+        files.insert(rel.to_string(), bytes);
+        Ok(())
+    };
+    // First what names the rest: the transforms files and the ground truth.
+    let mut files = FileSet::new();
+    for (rel, path) in &listing {
+        if super::is_dataset_index(rel) {
+            read(rel, path, &mut files)?;
+        }
+    }
+    for rel in super::dataset::referenced_paths(&files) {
+        if let Some(path) = listing.get(&rel) {
+            read(&rel, path, &mut files)?;
+        }
+    }
+    Ok(files)
+}
+
+/// `root` as a folder to read, or why it is not one.
+fn folder(root: &Path) -> Result<std::path::PathBuf, DataError> {
+    let shown = root.display().to_string();
+    let meta = fs::metadata(root)
+        .map_err(|e| DataError::file(&shown, format!("cannot open the dataset folder: {e}")))?;
+    if !meta.is_dir() {
+        return Err(DataError::file(
+            &shown,
+            "expected a dataset folder, found a file",
+        ));
+    }
+    Ok(root.to_path_buf())
+}
+
+/// Lists the non-hidden files below `dir` by relative path without reading them; names that
+/// are not UTF-8 and entries that cannot be inspected (a dangling symlink) are left out, since
+/// no transforms file can refer to them.
+fn list(
+    dir: &Path,
+    prefix: &str,
+    depth: usize,
+    out: &mut std::collections::BTreeMap<String, std::path::PathBuf>,
+) -> Result<(), DataError> {
+    let shown = if prefix.is_empty() { "." } else { prefix };
+    if depth > MAX_DEPTH {
+        return Err(DataError::file(
+            shown,
+            format!("folders nested more than {MAX_DEPTH} deep (a symlink loop?)"),
+        ));
+    }
+    let entries = fs::read_dir(dir)
+        .map_err(|e| DataError::file(shown, format!("cannot list folder: {e}")))?;
+    for entry in entries.flatten() {
+        let Ok(name) = entry.file_name().into_string() else {
+            continue;
+        };
+        if name.starts_with('.') {
+            continue;
+        }
+        let rel = if prefix.is_empty() {
+            name
+        } else {
+            format!("{prefix}/{name}")
+        };
+        let path = entry.path();
+        match fs::metadata(&path) {
+            Ok(meta) if meta.is_dir() => list(&path, &rel, depth + 1, out)?,
+            Ok(meta) if meta.is_file() => {
+                out.insert(rel, path);
+            }
+            _ => {}
+        }
+    }
+    Ok(())
 }
 
 /// Folders nested deeper than this are not followed (guards against symlink loops).

@@ -43,7 +43,7 @@ pub use dataset::{Dataset, GroundTruth, ViewSet};
 pub use error::{DataError, DatasetErrors};
 pub use frame::Frame;
 #[cfg(not(target_arch = "wasm32"))]
-pub use fs::{ReadDatasetError, read_dataset, read_dir, write_dir};
+pub use fs::{ReadDatasetError, read_dataset, read_dataset_files, read_dir, write_dir};
 pub use gt::{GtJoint, GtMeshes, JointKind};
 pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png};
 pub use npy::encode_npy;
@@ -136,6 +136,17 @@ impl std::fmt::Display for Split {
 /// Name of the transforms file for a split and state, e.g. `transforms_train_start.json`.
 pub(crate) fn transforms_file_name(split: Split, state: State) -> String {
     format!("transforms_{}_{}.json", split.name(), state.name())
+}
+
+/// Whether a dataset path is one that names the others or stands alone: a transforms file at the
+/// root, or anything under `gt/`.
+#[cfg(not(target_arch = "wasm32"))]
+pub(crate) fn is_dataset_index(rel: &str) -> bool {
+    rel.starts_with("gt/")
+        || State::ALL
+            .into_iter()
+            .flat_map(|state| Split::ALL.map(|split| transforms_file_name(split, state)))
+            .any(|name| name == rel)
 }
 
 /// Path of the ground-truth joints file.

@@ -122,7 +122,8 @@ pub async fn fit_and_export(
 #[cfg(not(target_arch = "wasm32"))]
 pub fn read_dataset(root: &std::path::Path) -> Result<FitInput, PipelineError> {
     let shown = root.display();
-    let files = crate::data::read_dir(root).map_err(|e| PipelineError::Dataset(e.to_string()))?;
+    let files =
+        crate::data::read_dataset_files(root).map_err(|e| PipelineError::Dataset(e.to_string()))?;
     let id = root
         .file_name()
         .map_or("object".into(), |n| n.to_string_lossy().into_owned());

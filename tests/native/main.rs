@@ -12,6 +12,7 @@ mod capture;
 mod cli;
 mod data_malformed;
 mod data_roundtrip;
+mod dataset_folder;
 mod eval_metrics;
 mod eval_metrics_objects;
 mod export;

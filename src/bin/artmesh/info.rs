@@ -53,7 +53,7 @@ pub struct SampleArgs {
 /// `artmesh info`: the dataset's summary, or every problem found (and failure).
 pub fn info(args: &InfoArgs) -> Result<ExitCode, String> {
     let root = &args.dataset;
-    let files = data::read_dir(root).map_err(|e| e.to_string())?;
+    let files = data::read_dataset_files(root).map_err(|e| e.to_string())?;
     match Dataset::from_files(&files) {
         Ok(dataset) => {
             let problems = artmesh::pipeline::check::fit_problems(&dataset);
