@@ -150,6 +150,35 @@ impl Reader<'_, '_> {
                 joint.mimic = Some(mimic);
             }
         }
+        // A chain of leaders must end at a joint that moves on its own.
+        for (j, node) in nodes.iter().enumerate() {
+            let mut chain = vec![j];
+            let mut at = j;
+            while let Some(next) = joints.get(at).and_then(|x| x.mimic).map(|m| m.joint) {
+                if next == j {
+                    let names: Vec<&str> = chain
+                        .iter()
+                        .chain([&j])
+                        .filter_map(|&i| joints.get(i).map(|x| x.name.as_str()))
+                        .collect();
+                    let name = names.first().copied().unwrap_or_default();
+                    return Err(self.err(
+                        child(*node, "mimic").unwrap_or(*node),
+                        &format!("robot/joint[name={name}]/mimic"),
+                        Some("joint"),
+                        format!(
+                            "the mimic joints {} follow each other in a cycle: one of them must move on its own",
+                            names.join(" → ")
+                        ),
+                    ));
+                }
+                if chain.len() > joints.len() {
+                    break; // a cycle further up the chain, reported from its own joint
+                }
+                chain.push(next);
+                at = next;
+            }
+        }
         Ok(())
     }
 

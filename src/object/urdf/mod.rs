@@ -198,6 +198,10 @@ mod tests {
                 "<robot name=\"t\"><link name=\"a\"><visual><geometry><mesh filename=\"package://nope/x.obj\"/></geometry></visual></link></robot>",
                 "no package.xml",
             ),
+            (
+                "<robot name=\"t\"><link name=\"a\"/><link name=\"b\"/><link name=\"c\"/><joint name=\"j\" type=\"continuous\"><parent link=\"a\"/><child link=\"b\"/><mimic joint=\"k\"/></joint><joint name=\"k\" type=\"continuous\"><parent link=\"b\"/><child link=\"c\"/><mimic joint=\"j\"/></joint></robot>",
+                "the mimic joints j → k → j follow each other in a cycle",
+            ),
             ("<robot><link", "well-formed"),
             ("<model/>", "<robot>"),
         ];
