@@ -61,11 +61,24 @@ impl Dataset {
     /// other and with `w`/`h`; depth and semantic maps match their image's size and are present for all
     /// frames of a split or none; part ids are -1..num_parts-1; GT meshes cover every movable part.
     pub fn from_files(files: &FileSet) -> Result<Dataset, DatasetErrors> {
+        Self::from_files_within(files, &ReadLimits::default())
+    }
+
+    /// [`Dataset::from_files`] within `limits`: a dataset whose images would decode to more than
+    /// the budget is refused before any is decoded, with the sizes and how to raise it.
+    pub fn from_files_within(
+        files: &FileSet,
+        limits: &ReadLimits,
+    ) -> Result<Dataset, DatasetErrors> {
         let mut errs = Errors::default();
         let gt_joints = files
             .get(GT_TRANS_PATH)
             .and_then(|b| gt::parse_trans(b, &mut errs));
-        let part_limit = gt_joints.as_ref().map(|j| j.len() + 1);
+        let mut context = ViewSetContext {
+            part_limit: gt_joints.as_ref().map(|j| j.len() + 1),
+            max_decoded_bytes: limits.max_decoded_bytes,
+            decoded_bytes: 0,
+        };
 
         let mut views = Vec::new();
         for state in State::ALL {
@@ -73,7 +86,7 @@ impl Dataset {
                 let file = transforms_file_name(split, state);
                 match files.get(&file) {
                     Some(bytes) => {
-                        if let Some(v) = read_view_set(files, &file, bytes, state, split, part_limit, &mut errs) {
+                        if let Some(v) = read_view_set(files, &file, bytes, state, split, &mut context, &mut errs) {
                             views.push(v);
                         }
                     }
@@ -159,6 +172,73 @@ impl Dataset {
     }
 }
 
+/// How much memory a dataset's decoded images may take.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadLimits {
+    /// Bytes of all decoded colour, depth and semantic images together (RGBA is 4 bytes a pixel,
+    /// depth and part ids 2).
+    pub max_decoded_bytes: u64,
+}
+
+impl Default for ReadLimits {
+    /// 8 GiB natively (the paper's 800² × 240 frames take 1.2 GB); 1.5 GiB in the browser, whose
+    /// wasm memory also holds the files themselves and the fit.
+    fn default() -> Self {
+        let gib = if cfg!(target_arch = "wasm32") {
+            1.5
+        } else {
+            8.0
+        };
+        ReadLimits {
+            max_decoded_bytes: (gib * (1u64 << 30) as f64) as u64,
+        }
+    }
+}
+
+/// What the view sets of one dataset share while they are read.
+struct ViewSetContext {
+    /// Part ids must stay below this (from `gt/trans.json`), if given.
+    part_limit: Option<usize>,
+    max_decoded_bytes: u64,
+    /// Decoded bytes of the view sets read so far.
+    decoded_bytes: u64,
+}
+
+/// Bytes a frame's images decode to, from their headers (0 for an image whose header does not
+/// read: its decoder names the problem).
+fn decoded_size(files: &FileSet, fs: &FrameSpec) -> u64 {
+    let png_pixels = |bytes: &[u8]| -> u64 {
+        match bytes.get(12..24) {
+            Some(h) if &h[..4] == b"IHDR" => {
+                let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
+                be(&h[4..8]) * be(&h[8..12])
+            }
+            _ => 0,
+        }
+    };
+    let Some((rgba_path, bytes)) = paths::image_candidates(&fs.file_path)
+        .into_iter()
+        .find_map(|p| files.get(&p).map(|b| (p, b)))
+    else {
+        return 0;
+    };
+    let mut total = 4 * png_pixels(bytes);
+    for (kind, exts) in [
+        ("depth", &[".png"][..]),
+        ("semantic", &[".png", ".npy"][..]),
+    ] {
+        if let Ok((path, b)) = find_sibling(files, &rgba_path, kind, exts) {
+            // An .npy holds its values uncompressed: it decodes to about its own size.
+            total += if path.ends_with(".npy") {
+                b.len() as u64
+            } else {
+                2 * png_pixels(b)
+            };
+        }
+    }
+    total
+}
+
 /// Reads one transforms file and the images it refers to.
 fn read_view_set(
     files: &FileSet,
@@ -166,10 +246,29 @@ fn read_view_set(
     bytes: &[u8],
     state: State,
     split: Split,
-    part_limit: Option<usize>,
+    context: &mut ViewSetContext,
     errs: &mut Errors,
 ) -> Option<ViewSet> {
     let spec = transforms::parse(file, bytes, errs)?;
+    // Refused before decoding: a few kilobytes of PNG can claim gigapixels, and one small image
+    // named by thousands of frames decodes once per frame.
+    let size: u64 = spec.frames.iter().map(|fs| decoded_size(files, fs)).sum();
+    context.decoded_bytes = context.decoded_bytes.saturating_add(size);
+    if context.decoded_bytes > context.max_decoded_bytes {
+        let mb = |b: u64| b as f64 / 1e6;
+        errs.push(DataError::file(
+            file,
+            format!(
+                "its {} frames' images decode to {:.0} MB, bringing the dataset to {:.0} MB, over the budget of {:.0} MB for a whole dataset's decoded images (--max-decoded-mb raises it)",
+                spec.frames.len(),
+                mb(size),
+                mb(context.decoded_bytes),
+                mb(context.max_decoded_bytes)
+            ),
+        ));
+        return None;
+    }
+    let part_limit = context.part_limit;
     let mut checks = SplitChecks::default();
     let mut frames = Vec::with_capacity(spec.frames.len());
     // Decoding is most of a large dataset's reading: all frames at once, then checked in order.

@@ -39,7 +39,7 @@ use std::collections::BTreeMap;
 
 pub use archive::read_zip;
 pub use camera::{Camera, Intrinsics, look_at};
-pub use dataset::{Dataset, GroundTruth, ViewSet};
+pub use dataset::{Dataset, GroundTruth, ReadLimits, ViewSet};
 pub use error::{DataError, DatasetErrors};
 pub use frame::Frame;
 #[cfg(not(target_arch = "wasm32"))]

@@ -9,7 +9,7 @@ pub mod demo;
 
 use std::fmt;
 
-use crate::data::{DataError, Dataset, FileSet};
+use crate::data::{DataError, Dataset, FileSet, ReadLimits};
 use crate::export::FitFolder;
 use crate::fit::object::{FitConfig, ObjectFit, fit_object};
 use crate::fit::observer::Observer;
@@ -120,20 +120,28 @@ pub async fn fit_and_export(
 /// Reads the dataset folder `root`, named after its last component (`object` when it has none),
 /// as [`dataset_from_files`] does; errors start with the folder's name.
 #[cfg(not(target_arch = "wasm32"))]
-pub fn read_dataset(root: &std::path::Path) -> Result<FitInput, PipelineError> {
+pub fn read_dataset(
+    root: &std::path::Path,
+    limits: &ReadLimits,
+) -> Result<FitInput, PipelineError> {
     let shown = root.display();
     let files =
         crate::data::read_dataset_files(root).map_err(|e| PipelineError::Dataset(e.to_string()))?;
     let id = root
         .file_name()
         .map_or("object".into(), |n| n.to_string_lossy().into_owned());
-    dataset_from_files(&files, id).map_err(|e| PipelineError::Dataset(format!("{shown}: {e}")))
+    dataset_from_files(&files, id, limits)
+        .map_err(|e| PipelineError::Dataset(format!("{shown}: {e}")))
 }
 
 /// A user's dataset, validated as a file set and then for what a fit needs
 /// ([`check::fit_problems`]); the error lists every problem found (the first 50 shown).
-pub fn dataset_from_files(files: &FileSet, id: String) -> Result<FitInput, PipelineError> {
-    let dataset = Dataset::from_files(files).map_err(|problems| {
+pub fn dataset_from_files(
+    files: &FileSet,
+    id: String,
+    limits: &ReadLimits,
+) -> Result<FitInput, PipelineError> {
+    let dataset = Dataset::from_files_within(files, limits).map_err(|problems| {
         PipelineError::Dataset(format!("{} problem(s):\n{problems}", problems.0.len()))
     })?;
     let problems = check::fit_problems(&dataset);

@@ -90,8 +90,8 @@ pub fn catalogue() -> String {
 pub struct WebDataset(Rc<FitInput>);
 
 fn dataset_from(files: &FileSet, name: String) -> Result<WebDataset, JsError> {
-    let input =
-        pipeline::dataset_from_files(files, name).map_err(|e| JsError::new(&e.to_string()))?;
+    let input = pipeline::dataset_from_files(files, name, &Default::default())
+        .map_err(|e| JsError::new(&e.to_string()))?;
     Ok(WebDataset(Rc::new(input)))
 }
 

@@ -151,3 +151,23 @@ pub fn context() -> Result<GpuContext, String> {
 pub fn to_json<T: serde::Serialize>(value: &T) -> Result<String, String> {
     serde_json::to_string_pretty(value).map_err(|e| e.to_string())
 }
+
+/// How much a dataset may take when read (flattened into `info` and `fit`).
+#[derive(clap::Args)]
+pub struct ReadArgs {
+    /// Budget for a whole dataset's decoded images, in MB [default: 8 GiB]: a dataset over it
+    /// is refused before decoding, naming its size.
+    #[arg(long, value_parser = clap::value_parser!(u64).range(1..))]
+    max_decoded_mb: Option<u64>,
+}
+
+impl ReadArgs {
+    /// The reader's limits these options ask for.
+    pub fn limits(&self) -> artmesh::data::ReadLimits {
+        let mut limits = artmesh::data::ReadLimits::default();
+        if let Some(mb) = self.max_decoded_mb {
+            limits.max_decoded_bytes = mb.saturating_mul(1_000_000);
+        }
+        limits
+    }
+}

@@ -12,7 +12,7 @@ use artmesh::fit::observer::Progress;
 use artmesh::fit::reconstruct::RemeshMode;
 use artmesh::pipeline::{self, FitInput};
 
-use crate::args::{BudgetArgs, context, to_json};
+use crate::args::{BudgetArgs, ReadArgs, context, to_json};
 use crate::output::NewFolder;
 use crate::progress;
 
@@ -40,6 +40,8 @@ pub struct FitArgs {
     geometry: Option<String>,
     #[command(flatten)]
     budget: BudgetArgs,
+    #[command(flatten)]
+    read: ReadArgs,
 }
 
 /// `artmesh fit`: the preset with the options, fitted to the dataset into a fresh folder.
@@ -53,7 +55,8 @@ pub fn run(args: FitArgs) -> Result<ExitCode, String> {
         config.articulation.geometry = GeometryUse::parse(&g).map_err(|e| e.to_string())?;
     }
     let folder = NewFolder::create(&args.out)?;
-    let input = pipeline::read_dataset(&args.dataset).map_err(|e| e.to_string())?;
+    let input =
+        pipeline::read_dataset(&args.dataset, &args.read.limits()).map_err(|e| e.to_string())?;
     let report = fit_and_write(&input, &config, folder.path(), &args.out)?;
     folder.finish()?;
     out!("{}", to_json(&report)?);

@@ -6,7 +6,7 @@ use std::process::ExitCode;
 use artmesh::data::{self, Dataset, fixture};
 use artmesh::gpu::selftest;
 
-use crate::args::{context, to_json};
+use crate::args::{ReadArgs, context, to_json};
 use crate::output::NewFolder;
 
 /// `artmesh info`'s arguments.
@@ -17,6 +17,8 @@ pub struct InfoArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
+    #[command(flatten)]
+    read: ReadArgs,
 }
 
 /// `artmesh gpu`'s arguments.
@@ -54,7 +56,7 @@ pub struct SampleArgs {
 pub fn info(args: &InfoArgs) -> Result<ExitCode, String> {
     let root = &args.dataset;
     let files = data::read_dataset_files(root).map_err(|e| e.to_string())?;
-    match Dataset::from_files(&files) {
+    match Dataset::from_files_within(&files, &args.read.limits()) {
         Ok(dataset) => {
             let problems = artmesh::pipeline::check::fit_problems(&dataset);
             if !problems.is_empty() {
