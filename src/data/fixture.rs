@@ -9,13 +9,14 @@ use glam::{Quat, Vec3};
 use serde_json::{Value, json};
 
 use super::camera::{Camera, Intrinsics, look_at};
-use super::dataset::{Dataset, ViewSet};
+use super::dataset::Dataset;
 use super::error::DataError;
 use super::frame::Frame;
 use super::gt::{self, GtJoint, GtMeshes, JointKind};
 use super::image_io::{DepthMap, PartMap, RgbaImage};
 use super::npy::encode_npy;
 use super::ply::{PlyFormat, TriMesh};
+use super::view_set::ViewSet;
 use super::{FileSet, GT_TRANS_PATH, Split, State, transforms_file_name};
 
 /// Shape of the generated dataset.

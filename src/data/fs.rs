@@ -4,8 +4,11 @@ use std::fs;
 use std::io::Write;
 use std::path::{Component, Path};
 
+use std::collections::BTreeSet;
+
 use super::FileSet;
-use super::error::{DataError, DatasetErrors};
+use super::error::{DataError, DatasetErrors, Errors};
+use super::{Split, State};
 
 /// Why [`read_dataset`] found no valid dataset.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -53,12 +56,44 @@ pub fn read_dataset_files(root: &Path) -> Result<FileSet, DataError> {
             read(rel, path, &mut files)?;
         }
     }
-    for rel in super::dataset::referenced_paths(&files) {
+    for rel in referenced_paths(&files) {
         if let Some(path) = listing.get(&rel) {
             read(&rel, path, &mut files)?;
         }
     }
     Ok(files)
+}
+
+/// Every path the transforms files in `files` refer to, with each image's depth and semantic
+/// siblings under every name the reader tries: what a reader of a folder needs to read besides
+/// the transforms files and `gt/`. Malformed transforms files contribute what they can; their
+/// errors are the reader's to report.
+fn referenced_paths(files: &FileSet) -> BTreeSet<String> {
+    let mut wanted = BTreeSet::new();
+    for state in State::ALL {
+        for split in Split::ALL {
+            let file = super::transforms_file_name(split, state);
+            let Some(bytes) = files.get(&file) else {
+                continue;
+            };
+            let Some(spec) = super::transforms::parse(&file, bytes, &mut Errors::default()) else {
+                continue;
+            };
+            for fs in &spec.frames {
+                for image in super::paths::image_candidates(&fs.file_path) {
+                    for (kind, ext) in [
+                        ("depth", ".png"),
+                        ("semantic", ".png"),
+                        ("semantic", ".npy"),
+                    ] {
+                        wanted.extend(super::paths::sibling(&image, kind, ext));
+                    }
+                    wanted.insert(image);
+                }
+            }
+        }
+    }
+    wanted
 }
 
 /// `root` as a folder to read, or why it is not one.

@@ -33,13 +33,14 @@ mod paths;
 mod ply;
 mod summary;
 mod transforms;
+mod view_set;
 mod writer;
 
 use std::collections::BTreeMap;
 
 pub use archive::read_zip;
 pub use camera::{Camera, Intrinsics, look_at};
-pub use dataset::{Dataset, GroundTruth, ReadLimits, ViewSet};
+pub use dataset::{Dataset, GroundTruth};
 pub use error::{DataError, DatasetErrors};
 pub use frame::Frame;
 #[cfg(not(target_arch = "wasm32"))]
@@ -50,6 +51,7 @@ pub use npy::encode_npy;
 pub use paths::rebase_on_dataset_root;
 pub use ply::{PlyFormat, TriMesh};
 pub use summary::{Summary, ViewSummary};
+pub use view_set::{ReadLimits, ViewSet};
 pub use writer::{DatasetWriter, SemanticFormat, WriteOptions};
 
 /// A dataset as bytes: relative path (`'/'` separators, e.g. `start/train/rgba/0000.png`) → file contents.
