@@ -10,7 +10,7 @@
 //! world coordinates, `l` / `r` the joint values at start / end (degrees for revolute and continuous joints,
 //! metres for prismatic ones). Objects the part model cannot describe are refused with a clear
 //! [`ObjectProblem`]: nothing moves, a movable part hanging on another movable part, a movable part without
-//! surface, an object smaller than [`MIN_OBJECT_SIZE`], a joint whose range is empty. A static base without
+//! surface, an object smaller than [`MIN_OBJECT_SIZE`] or larger than [`MAX_OBJECT_SIZE`], a joint whose range is empty. A static base without
 //! surface is allowed (a door without its frame); its GT mesh is then empty and evaluation reports no CD-s.
 
 use glam::{Affine3A, Vec3};
@@ -27,6 +27,10 @@ use crate::rng::Rng;
 
 /// Objects whose bounding box diagonal is below this (metres) are refused as having no volume to image.
 pub const MIN_OBJECT_SIZE: f32 = 1e-3;
+
+/// Largest bounding-box diagonal of an object in metres: framed by the cameras, a larger one puts
+/// depths past the 65.535 m a millimetre depth PNG holds.
+pub const MAX_OBJECT_SIZE: f32 = 25.0;
 
 /// How to render a dataset. [`Default`] is the paper's Articulate-100 setting.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -107,6 +111,18 @@ pub enum ObjectProblem {
         /// [`MIN_OBJECT_SIZE`].
         min: f32,
     },
+    /// The object is too large (or has a non-finite vertex) for the depth maps to hold it.
+    #[error(
+        "object '{name}' spans {size:?} m across both states: a capture needs a bounding-box diagonal of at most {max} m (depth PNGs hold up to 65.535 m); check the mesh's units and <mesh scale>"
+    )]
+    TooLarge {
+        /// Object name.
+        name: String,
+        /// Bounding-box size.
+        size: [f32; 3],
+        /// [`MAX_OBJECT_SIZE`].
+        max: f32,
+    },
     /// A joint whose lower and upper limits coincide: both states would be the same.
     #[error(
         "joint '{joint}' has an empty range [{lower}, {upper}]: start and end states would be identical"
@@ -178,6 +194,31 @@ fn truth_of_posed(
     let parts = obj.parts();
     if parts.movable_count() == 0 {
         return Err(ObjectProblem::NothingMoves(obj.name.clone()));
+    }
+    // The size before the surfaces: an overflowing one also makes their areas non-finite.
+    let (lo, hi) =
+        mesh_bounds(posed.iter().flatten().map(|m| &m.mesh)).unwrap_or((Vec3::ZERO, Vec3::ZERO));
+    // A vertex that is not finite once posed (3e38, moved) counts as an infinite size: the
+    // bounds leave it out, and the cameras would be NaN.
+    let finite = posed
+        .iter()
+        .flatten()
+        .all(|m| m.mesh.positions.iter().all(|p| p.is_finite()));
+    let size = if finite { hi - lo } else { Vec3::INFINITY };
+    let diagonal = size.length();
+    if diagonal.is_nan() || diagonal > MAX_OBJECT_SIZE {
+        return Err(ObjectProblem::TooLarge {
+            name: obj.name.clone(),
+            size: size.to_array(),
+            max: MAX_OBJECT_SIZE,
+        });
+    }
+    if diagonal < MIN_OBJECT_SIZE {
+        return Err(ObjectProblem::ZeroVolume {
+            name: obj.name.clone(),
+            size: size.to_array(),
+            min: MIN_OBJECT_SIZE,
+        });
     }
     let start_poses = obj.forward_kinematics(&states[0]);
     let mut joints = Vec::with_capacity(parts.movable_count());
@@ -328,14 +369,6 @@ pub async fn render_dataset(
     let (lo, hi) =
         mesh_bounds(posed.iter().flatten().map(|m| &m.mesh)).unwrap_or((Vec3::ZERO, Vec3::ZERO));
     let size = hi - lo;
-    if size.length() < MIN_OBJECT_SIZE {
-        return Err(ObjectProblem::ZeroVolume {
-            name: obj.name.clone(),
-            size: size.to_array(),
-            min: MIN_OBJECT_SIZE,
-        }
-        .into());
-    }
     let renderer = GtRenderer::new(ctx, spec.width, spec.height)?;
     let template = Camera::from_fov(
         glam::Mat4::IDENTITY,

@@ -281,6 +281,30 @@ fn objects_outside_the_part_model_are_clear_errors() {
     let p = problem(&b.build());
     assert!(matches!(p, ObjectProblem::ZeroVolume { .. }), "{p}");
     assert!(p.to_string().contains("zero volume"), "{p}");
+    // Too large for the depth maps (a mesh in millimetres read as metres), or a vertex at 3e38.
+    for (name, far) in [("stadium", 1e3f32), ("overflow", 3e38)] {
+        let mut b = ObjectBuilder::new(name);
+        b.add(
+            ObjectBuilder::BASE,
+            cuboid(Vec3::ZERO, Vec3::ONE, &Material::default()),
+        );
+        let lid = b.joint(
+            "lid",
+            ObjectBuilder::BASE,
+            JointKind::Revolute,
+            Vec3::ZERO,
+            Vec3::X,
+            0.0,
+            1.0,
+        );
+        b.add(
+            lid,
+            cuboid(Vec3::splat(far), Vec3::ONE, &Material::default()),
+        );
+        let p = problem(&b.build());
+        assert!(matches!(p, ObjectProblem::TooLarge { .. }), "{name}: {p}");
+        assert!(p.to_string().contains("at most 25 m"), "{p}");
+    }
     // A part hanging on another movable part.
     let mut nested = door_object(door, 0.0, 1.0, JointKind::Revolute);
     let knob_parent = nested.joints[0].child;
