@@ -1,14 +1,12 @@
 //! Native-only bridge between a folder on disk and a [`FileSet`]. Never overwrites anything.
 
+use std::collections::{BTreeMap, BTreeSet};
 use std::fs;
 use std::io::Write;
-use std::path::{Component, Path};
+use std::path::{Component, Path, PathBuf};
 
-use std::collections::BTreeSet;
-
-use super::FileSet;
 use super::error::{DataError, DatasetErrors, Errors};
-use super::{Split, State};
+use super::{FileSet, Split, State};
 
 /// Why [`read_dataset`] found no valid dataset.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -41,24 +39,18 @@ pub fn read_dataset(root: &Path) -> Result<super::Dataset, ReadDatasetError> {
 /// semantic siblings). An unrelated video beside the frames, a name that is not UTF-8 or a
 /// dangling symlink elsewhere in the folder is never read and never an error.
 pub fn read_dataset_files(root: &Path) -> Result<FileSet, DataError> {
-    let mut listing = std::collections::BTreeMap::new();
-    list(&folder(root)?, "", 0, &mut listing)?;
-    let read = |rel: &str, path: &Path, files: &mut FileSet| -> Result<(), DataError> {
-        let bytes =
-            fs::read(path).map_err(|e| DataError::file(rel, format!("cannot read: {e}")))?;
-        files.insert(rel.to_string(), bytes);
-        Ok(())
-    };
+    let mut listing = Listing::new();
+    list(&folder(root)?, "", 0, Strictness::Lenient, &mut listing)?;
     // First what names the rest: the transforms files and the ground truth.
     let mut files = FileSet::new();
     for (rel, path) in &listing {
         if super::is_dataset_index(rel) {
-            read(rel, path, &mut files)?;
+            read_into(rel, path, &mut files)?;
         }
     }
     for rel in referenced_paths(&files) {
         if let Some(path) = listing.get(&rel) {
-            read(&rel, path, &mut files)?;
+            read_into(&rel, path, &mut files)?;
         }
     }
     Ok(files)
@@ -81,12 +73,11 @@ fn referenced_paths(files: &FileSet) -> BTreeSet<String> {
             };
             for fs in &spec.frames {
                 for image in super::paths::image_candidates(&fs.file_path) {
-                    for (kind, ext) in [
-                        ("depth", ".png"),
-                        ("semantic", ".png"),
-                        ("semantic", ".npy"),
-                    ] {
-                        wanted.extend(super::paths::sibling(&image, kind, ext));
+                    for (kind, exts) in super::paths::SIBLINGS {
+                        wanted.extend(
+                            exts.iter()
+                                .filter_map(|e| super::paths::sibling(&image, kind, e)),
+                        );
                     }
                     wanted.insert(image);
                 }
@@ -97,7 +88,7 @@ fn referenced_paths(files: &FileSet) -> BTreeSet<String> {
 }
 
 /// `root` as a folder to read, or why it is not one.
-fn folder(root: &Path) -> Result<std::path::PathBuf, DataError> {
+fn folder(root: &Path) -> Result<PathBuf, DataError> {
     let shown = root.display().to_string();
     let meta = fs::metadata(root)
         .map_err(|e| DataError::file(&shown, format!("cannot open the dataset folder: {e}")))?;
@@ -110,14 +101,27 @@ fn folder(root: &Path) -> Result<std::path::PathBuf, DataError> {
     Ok(root.to_path_buf())
 }
 
-/// Lists the non-hidden files below `dir` by relative path without reading them; names that
-/// are not UTF-8 and entries that cannot be inspected (a dangling symlink) are left out, since
-/// no transforms file can refer to them.
+/// Non-hidden files below a folder, by `'/'`-separated relative path.
+type Listing = BTreeMap<String, PathBuf>;
+
+/// What [`list`] does with an entry it cannot use.
+#[derive(Clone, Copy, PartialEq)]
+enum Strictness {
+    /// A name that is not UTF-8 or an entry that cannot be inspected (a dangling symlink) is an
+    /// error: [`read_dir`] reads everything, so it must be able to name everything.
+    Strict,
+    /// Such entries are left out: no transforms file can refer to them.
+    Lenient,
+}
+
+/// Lists the non-hidden files below `dir` without reading them. Follows symlinks, so linked
+/// folders and files are listed like real ones.
 fn list(
     dir: &Path,
     prefix: &str,
     depth: usize,
-    out: &mut std::collections::BTreeMap<String, std::path::PathBuf>,
+    strictness: Strictness,
+    out: &mut Listing,
 ) -> Result<(), DataError> {
     let shown = if prefix.is_empty() { "." } else { prefix };
     if depth > MAX_DEPTH {
@@ -126,11 +130,24 @@ fn list(
             format!("folders nested more than {MAX_DEPTH} deep (a symlink loop?)"),
         ));
     }
-    let entries = fs::read_dir(dir)
-        .map_err(|e| DataError::file(shown, format!("cannot list folder: {e}")))?;
-    for entry in entries.flatten() {
-        let Ok(name) = entry.file_name().into_string() else {
-            continue;
+    let strict = strictness == Strictness::Strict;
+    let cannot_list =
+        |e: std::io::Error| DataError::file(shown, format!("cannot list folder: {e}"));
+    for entry in fs::read_dir(dir).map_err(cannot_list)? {
+        let entry = match entry {
+            Ok(entry) => entry,
+            Err(e) if strict => return Err(cannot_list(e)),
+            Err(_) => continue,
+        };
+        let name = match entry.file_name().into_string() {
+            Ok(name) => name,
+            Err(raw) if strict => {
+                return Err(DataError::file(
+                    shown,
+                    format!("file name {raw:?} is not valid UTF-8"),
+                ));
+            }
+            Err(_) => continue,
         };
         if name.starts_with('.') {
             continue;
@@ -142,13 +159,22 @@ fn list(
         };
         let path = entry.path();
         match fs::metadata(&path) {
-            Ok(meta) if meta.is_dir() => list(&path, &rel, depth + 1, out)?,
+            Ok(meta) if meta.is_dir() => list(&path, &rel, depth + 1, strictness, out)?,
             Ok(meta) if meta.is_file() => {
                 out.insert(rel, path);
             }
-            _ => {}
+            Ok(_) => {}
+            Err(e) if strict => return Err(DataError::file(&rel, format!("cannot read: {e}"))),
+            Err(_) => {}
         }
     }
+    Ok(())
+}
+
+/// Reads the file at `path` into `files` under `rel`.
+fn read_into(rel: &str, path: &Path, files: &mut FileSet) -> Result<(), DataError> {
+    let bytes = fs::read(path).map_err(|e| DataError::file(rel, format!("cannot read: {e}")))?;
+    files.insert(rel.to_string(), bytes);
     Ok(())
 }
 
@@ -158,65 +184,13 @@ const MAX_DEPTH: usize = 32;
 /// Reads every non-hidden file below `root` into a [`FileSet`] keyed by `'/'`-separated relative path.
 /// Hidden files and folders (name starting with `.`) are skipped. Read-only.
 pub fn read_dir(root: &Path) -> Result<FileSet, DataError> {
-    let shown = root.display().to_string();
-    let meta = fs::metadata(root)
-        .map_err(|e| DataError::file(&shown, format!("cannot open the dataset folder: {e}")))?;
-    if !meta.is_dir() {
-        return Err(DataError::file(
-            &shown,
-            "expected a dataset folder, found a file",
-        ));
-    }
+    let mut listing = Listing::new();
+    list(&folder(root)?, "", 0, Strictness::Strict, &mut listing)?;
     let mut files = FileSet::new();
-    walk(root, "", 0, &mut files)?;
+    for (rel, path) in &listing {
+        read_into(rel, path, &mut files)?;
+    }
     Ok(files)
-}
-
-fn walk(dir: &Path, prefix: &str, depth: usize, files: &mut FileSet) -> Result<(), DataError> {
-    let shown = if prefix.is_empty() {
-        ".".to_string()
-    } else {
-        prefix.to_string()
-    };
-    if depth > MAX_DEPTH {
-        return Err(DataError::file(
-            shown,
-            format!("folders nested more than {MAX_DEPTH} deep (a symlink loop?)"),
-        ));
-    }
-    let entries = fs::read_dir(dir)
-        .map_err(|e| DataError::file(&shown, format!("cannot list folder: {e}")))?;
-    for entry in entries {
-        let entry =
-            entry.map_err(|e| DataError::file(&shown, format!("cannot list folder: {e}")))?;
-        let name = entry.file_name();
-        let Some(name) = name.to_str() else {
-            return Err(DataError::file(
-                &shown,
-                format!("file name {:?} is not valid UTF-8", entry.file_name()),
-            ));
-        };
-        if name.starts_with('.') {
-            continue;
-        }
-        let rel = if prefix.is_empty() {
-            name.to_string()
-        } else {
-            format!("{prefix}/{name}")
-        };
-        let path = entry.path();
-        // Follows symlinks, so linked folders and files are read like real ones.
-        let meta =
-            fs::metadata(&path).map_err(|e| DataError::file(&rel, format!("cannot read: {e}")))?;
-        if meta.is_dir() {
-            walk(&path, &rel, depth + 1, files)?;
-        } else if meta.is_file() {
-            let bytes =
-                fs::read(&path).map_err(|e| DataError::file(&rel, format!("cannot read: {e}")))?;
-            files.insert(rel, bytes);
-        }
-    }
-    Ok(())
 }
 
 /// Writes a [`FileSet`] below `root` (created if needed). Refuses to overwrite: if any file already exists,

@@ -55,6 +55,11 @@ fn strip_png(s: &str) -> &str {
     }
 }
 
+/// The optional maps beside a frame's rgba image: each kind's folder name and the extensions
+/// tried, in order (depth is index 0, semantic 1 everywhere a reader counts them).
+pub(crate) const SIBLINGS: [(&str, &[&str]); 2] =
+    [("depth", &[".png"]), ("semantic", &[".png", ".npy"])];
+
 /// The depth or semantic file belonging to an rgba image: the last directory component named `rgba` is replaced
 /// by `kind`, and the extension by `ext` (ArtGS does `path.replace('rgba', 'depth')`; we do it per component so
 /// a file called `rgba_0.png` is left alone). `None` when the path has no `rgba` directory.

@@ -65,41 +65,6 @@ pub(super) struct ViewSetContext {
     pub(super) decoded_bytes: u64,
 }
 
-/// Bytes a frame's images decode to, from their headers (0 for an image whose header does not
-/// read: its decoder names the problem).
-fn decoded_size(files: &FileSet, fs: &FrameSpec) -> u64 {
-    let png_pixels = |bytes: &[u8]| -> u64 {
-        match bytes.get(12..24) {
-            Some(h) if &h[..4] == b"IHDR" => {
-                let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
-                be(&h[4..8]) * be(&h[8..12])
-            }
-            _ => 0,
-        }
-    };
-    let Some((rgba_path, bytes)) = paths::image_candidates(&fs.file_path)
-        .into_iter()
-        .find_map(|p| files.get(&p).map(|b| (p, b)))
-    else {
-        return 0;
-    };
-    let mut total = 4 * png_pixels(bytes);
-    for (kind, exts) in [
-        ("depth", &[".png"][..]),
-        ("semantic", &[".png", ".npy"][..]),
-    ] {
-        if let Ok((path, b)) = find_sibling(files, &rgba_path, kind, exts) {
-            // An .npy holds its values uncompressed: it decodes to about its own size.
-            total += if path.ends_with(".npy") {
-                b.len() as u64
-            } else {
-                2 * png_pixels(b)
-            };
-        }
-    }
-    total
-}
-
 /// Reads one transforms file and the images it refers to.
 pub(super) fn read_view_set(
     files: &FileSet,
@@ -113,7 +78,8 @@ pub(super) fn read_view_set(
     let spec = transforms::parse(file, bytes, errs)?;
     // Refused before decoding: a few kilobytes of PNG can claim gigapixels, and one small image
     // named by thousands of frames decodes once per frame.
-    let size: u64 = spec.frames.iter().map(|fs| decoded_size(files, fs)).sum();
+    let found: Vec<FrameFiles> = spec.frames.iter().map(|fs| find_frame(files, fs)).collect();
+    let size: u64 = found.iter().map(FrameFiles::decoded_size).sum();
     context.decoded_bytes = context.decoded_bytes.saturating_add(size);
     if context.decoded_bytes > context.max_decoded_bytes {
         let mb = |b: u64| b as f64 / 1e6;
@@ -133,7 +99,7 @@ pub(super) fn read_view_set(
     let mut checks = SplitChecks::default();
     let mut frames = Vec::with_capacity(spec.frames.len());
     // Decoding is most of a large dataset's reading: all frames at once, then checked in order.
-    let decoded = parallel::map(&spec.frames, |fs| decode_frame(files, fs));
+    let decoded = parallel::map(&found, FrameFiles::decode);
     for (fs, decoded) in spec.frames.iter().zip(decoded) {
         if let Some(frame) = read_frame(file, fs, decoded, state, part_limit, &mut checks, errs) {
             frames.push(frame);
@@ -174,44 +140,97 @@ struct DecodedFrame {
     parts: Option<Found<PartMap>>,
 }
 
-/// Finds and decodes a frame's colour image and its optional depth and semantic maps.
-fn decode_frame(files: &FileSet, fs: &FrameSpec) -> DecodedFrame {
+/// An optional file of a frame found in the file set (path and bytes), or the path it was
+/// expected at.
+type Located<'a> = Result<(String, &'a [u8]), String>;
+
+/// A frame's files as found in the file set, before decoding.
+struct FrameFiles<'a> {
+    /// The colour image's path and bytes, or every path it was looked for under.
+    rgba: Result<(String, &'a [u8]), Vec<String>>,
+    /// Depth and semantic map ([`paths::SIBLINGS`] order): the file found, or the path it was
+    /// expected at; none when the colour image itself is missing.
+    siblings: Option<[Located<'a>; 2]>,
+}
+
+/// Finds a frame's colour image and its optional depth and semantic maps.
+fn find_frame<'a>(files: &'a FileSet, fs: &FrameSpec) -> FrameFiles<'a> {
     let candidates = paths::image_candidates(&fs.file_path);
     let Some((rgba_path, bytes)) = candidates
         .iter()
-        .find_map(|p| files.get(p).map(|b| (p.clone(), b)))
+        .find_map(|p| files.get(p).map(|b| (p.clone(), b.as_slice())))
     else {
-        return DecodedFrame {
+        return FrameFiles {
             rgba: Err(candidates),
-            depth: None,
-            parts: None,
+            siblings: None,
         };
     };
-    let depth = find_sibling(files, &rgba_path, "depth", &[".png"])
-        .map(|(path, b)| (path.clone(), image_io::decode_depth(&path, b)));
-    let parts = find_sibling(files, &rgba_path, "semantic", &[".png", ".npy"]).map(|(path, b)| {
-        let map = if path.ends_with(".npy") {
-            npy::decode_parts_npy(&path, b)
-        } else {
-            image_io::decode_parts_png(&path, b)
-        };
-        (path, map)
-    });
-    DecodedFrame {
-        rgba: Ok((rgba_path.clone(), image_io::decode_rgba(&rgba_path, bytes))),
-        depth: Some(depth),
-        parts: Some(parts),
+    let siblings = [0, 1].map(|k| find_sibling(files, &rgba_path, k));
+    FrameFiles {
+        rgba: Ok((rgba_path, bytes)),
+        siblings: Some(siblings),
     }
 }
 
-/// The optional `kind` file of a frame (`depth`, `semantic`) under the first of `exts` present,
-/// or the path it was expected at.
-fn find_sibling<'a>(
-    files: &'a FileSet,
-    rgba_path: &str,
-    kind: &str,
-    exts: &[&str],
-) -> Result<(String, &'a [u8]), String> {
+impl FrameFiles<'_> {
+    /// Bytes the images decode to, from their headers (0 for an image whose header does not
+    /// read: its decoder names the problem).
+    fn decoded_size(&self) -> u64 {
+        let png_pixels = |bytes: &[u8]| -> u64 {
+            match bytes.get(12..24) {
+                Some(h) if &h[..4] == b"IHDR" => {
+                    let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
+                    be(&h[4..8]) * be(&h[8..12])
+                }
+                _ => 0,
+            }
+        };
+        let rgba = self.rgba.as_ref().map_or(0, |(_, b)| 4 * png_pixels(b));
+        let siblings = self.siblings.iter().flatten().flatten().map(|(path, b)| {
+            // An .npy holds its values uncompressed: it decodes to about its own size.
+            if path.ends_with(".npy") {
+                b.len() as u64
+            } else {
+                2 * png_pixels(b)
+            }
+        });
+        rgba + siblings.sum::<u64>()
+    }
+
+    /// Decodes every image found.
+    fn decode(&self) -> DecodedFrame {
+        let rgba = match &self.rgba {
+            Ok((path, bytes)) => Ok((path.clone(), image_io::decode_rgba(path, bytes))),
+            Err(candidates) => Err(candidates.clone()),
+        };
+        let [depth, parts] = match &self.siblings {
+            Some([depth, parts]) => [Some(depth), Some(parts)],
+            None => [None, None],
+        };
+        let depth = depth.map(|found| {
+            found.clone().map(|(path, b)| {
+                let map = image_io::decode_depth(&path, b);
+                (path, map)
+            })
+        });
+        let parts = parts.map(|found| {
+            found.clone().map(|(path, b)| {
+                let map = if path.ends_with(".npy") {
+                    npy::decode_parts_npy(&path, b)
+                } else {
+                    image_io::decode_parts_png(&path, b)
+                };
+                (path, map)
+            })
+        });
+        DecodedFrame { rgba, depth, parts }
+    }
+}
+
+/// The optional map `k` of a frame ([`paths::SIBLINGS`]: 0 depth, 1 semantic) under the first of
+/// its extensions present, or the path it was expected at.
+fn find_sibling<'a>(files: &'a FileSet, rgba_path: &str, k: usize) -> Located<'a> {
+    let (kind, exts) = paths::SIBLINGS[k];
     let candidates: Vec<String> = exts
         .iter()
         .filter_map(|e| paths::sibling(rgba_path, kind, e))

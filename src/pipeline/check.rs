@@ -54,6 +54,19 @@ pub fn fit_problems(dataset: &Dataset) -> Vec<String> {
     problems
 }
 
+/// [`fit_problems`] as one message, the way `info`, `fit` and the page say it; `None` when a
+/// fit can start.
+pub fn fit_refusal(dataset: &Dataset) -> Option<String> {
+    let problems = fit_problems(dataset);
+    (!problems.is_empty()).then(|| {
+        format!(
+            "the dataset reads, but a fit would stop on {} problem(s):\n{}",
+            problems.len(),
+            problems.join("\n")
+        )
+    })
+}
+
 /// Why no frame has a pixel the reconstruction can start from (foreground, valid depth, a
 /// part id), naming the map at fault; `None` when some frame has one.
 fn no_start(frames: &[Frame]) -> Option<&'static str> {

@@ -144,13 +144,8 @@ pub fn dataset_from_files(
     let dataset = Dataset::from_files_within(files, limits).map_err(|problems| {
         PipelineError::Dataset(format!("{} problem(s):\n{problems}", problems.0.len()))
     })?;
-    let problems = check::fit_problems(&dataset);
-    if !problems.is_empty() {
-        return Err(PipelineError::Dataset(format!(
-            "the dataset reads, but a fit would stop on {} problem(s):\n{}",
-            problems.len(),
-            problems.join("\n")
-        )));
+    if let Some(refusal) = check::fit_refusal(&dataset) {
+        return Err(PipelineError::Dataset(refusal));
     }
     Ok(FitInput::user(dataset, id))
 }

@@ -182,15 +182,16 @@ pub fn capture_truth(
     states: [Vec<f32>; 2],
 ) -> Result<CaptureTruth, ObjectProblem> {
     let posed = states.each_ref().map(|q| posed_part_meshes(obj, q));
-    truth_of_posed(obj, states, &posed)
+    truth_of_posed(obj, states, &posed).map(|(truth, _)| truth)
 }
 
-/// [`capture_truth`] for meshes already posed at `states` (the renderer needs them too).
+/// [`capture_truth`] for meshes already posed at `states` (the renderer needs them too), with
+/// the posed meshes' bounding box over both states (the renderer frames it).
 fn truth_of_posed(
     obj: &ArticulatedObject,
     states: [Vec<f32>; 2],
     posed: &[Vec<PartMesh>; 2],
-) -> Result<CaptureTruth, ObjectProblem> {
+) -> Result<(CaptureTruth, (Vec3, Vec3)), ObjectProblem> {
     let parts = obj.parts();
     if parts.movable_count() == 0 {
         return Err(ObjectProblem::NothingMoves(obj.name.clone()));
@@ -206,7 +207,7 @@ fn truth_of_posed(
         .all(|m| m.mesh.positions.iter().all(|p| p.is_finite()));
     let size = if finite { hi - lo } else { Vec3::INFINITY };
     let diagonal = size.length();
-    if diagonal.is_nan() || diagonal > MAX_OBJECT_SIZE {
+    if diagonal > MAX_OBJECT_SIZE {
         return Err(ObjectProblem::TooLarge {
             name: obj.name.clone(),
             size: size.to_array(),
@@ -281,11 +282,12 @@ fn truth_of_posed(
             movable: m,
         }
     });
-    Ok(CaptureTruth {
+    let truth = CaptureTruth {
         states,
         joints,
         meshes: [start, end],
-    })
+    };
+    Ok((truth, (lo, hi)))
 }
 
 /// One merged triangle mesh per part.
@@ -364,10 +366,8 @@ pub async fn render_dataset(
         sample_state(obj, spec.end_range, &mut rng),
     ];
     let posed = states.each_ref().map(|q| posed_part_meshes(obj, q));
-    let truth = truth_of_posed(obj, states, &posed)?;
     // Framed on both states at once.
-    let (lo, hi) =
-        mesh_bounds(posed.iter().flatten().map(|m| &m.mesh)).unwrap_or((Vec3::ZERO, Vec3::ZERO));
+    let (truth, (lo, hi)) = truth_of_posed(obj, states, &posed)?;
     let size = hi - lo;
     let renderer = GtRenderer::new(ctx, spec.width, spec.height)?;
     let template = Camera::from_fov(

@@ -58,14 +58,8 @@ pub fn info(args: &InfoArgs) -> Result<ExitCode, String> {
     let files = data::read_dataset_files(root).map_err(|e| e.to_string())?;
     match Dataset::from_files_within(&files, &args.read.limits()) {
         Ok(dataset) => {
-            let problems = artmesh::pipeline::check::fit_problems(&dataset);
-            if !problems.is_empty() {
-                eprintln!(
-                    "{}: the dataset reads, but a fit would stop on {} problem(s):",
-                    root.display(),
-                    problems.len()
-                );
-                eprintln!("{}", problems.join("\n"));
+            if let Some(refusal) = artmesh::pipeline::check::fit_refusal(&dataset) {
+                eprintln!("{}: {refusal}", root.display());
                 return Ok(ExitCode::FAILURE);
             }
             let summary = dataset.summary();
