@@ -1,6 +1,7 @@
 //! glTF 2.0 reader (GLB or `.gltf` JSON with external or `data:` buffers): walks the default scene's node
 //! tree, reads triangle primitives through bounds-checked accessors, and decodes PNG base-colour textures.
 
+use std::borrow::Cow;
 use std::collections::HashMap;
 use std::sync::Arc;
 
@@ -9,16 +10,24 @@ use glam::{Affine3A, Mat4, Vec2, Vec3};
 use crate::data::{DataError, FileSet, RgbaImage};
 use crate::object::{Material, RenderMesh};
 
-use super::shared::{decode_texture, folder_of, join_relative, triangles, vertex_normals};
+use super::shared::{Textures, folder_of, join_relative, triangles, vertex_normals};
 
 /// Nodes nested deeper than this are rejected (guards against cyclic node graphs).
 const MAX_NODE_DEPTH: usize = 64;
+
+/// Node instances a scene may expand to. A node listed by several parents is instanced once per
+/// path to it, so a small file can describe 2⁴⁰ instances; real assets stay far below this.
+pub(crate) const MAX_NODE_INSTANCES: usize = 200_000;
+
+/// Triangles one glTF file may instance, over all its nodes (20 M: about 1 GB of vertex data).
+pub(crate) const MAX_GLTF_TRIANGLES: usize = 20_000_000;
 
 /// Reads a GLB or `.gltf` file; meshes come out in the scene's frame (node transforms applied).
 pub(super) fn read_gltf(
     path: &str,
     bytes: &[u8],
     files: &FileSet,
+    textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
     let gltf = gltf::Gltf::from_slice(bytes)
@@ -31,7 +40,10 @@ pub(super) fn read_gltf(
         gltf: &gltf,
         buffers,
         files,
-        images: HashMap::new(),
+        textures,
+        meshes: HashMap::new(),
+        instances: 0,
+        triangles: 0,
         out: Vec::new(),
     };
     let scene = gltf.default_scene().or_else(|| gltf.scenes().next());
@@ -51,22 +63,25 @@ pub(super) fn read_gltf(
     Ok(reader.out)
 }
 
-/// Bytes of every buffer (GLB chunk, external file or data URI), each checked against its declared length.
-fn load_buffers(
+/// Bytes of every buffer (GLB chunk, external file or data URI), each checked against its declared
+/// length. Files and the GLB chunk are borrowed, so many buffers naming one file cost nothing.
+fn load_buffers<'a>(
     path: &str,
     folder: &str,
-    gltf: &gltf::Gltf,
-    files: &FileSet,
-) -> Result<Vec<Vec<u8>>, DataError> {
+    gltf: &'a gltf::Gltf,
+    files: &'a FileSet,
+) -> Result<Vec<Cow<'a, [u8]>>, DataError> {
     let mut out = Vec::new();
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
-                DataError::file(
-                    path,
-                    "glTF buffer refers to the GLB binary chunk, which is missing",
-                )
-            })?,
+            gltf::buffer::Source::Bin => {
+                gltf.blob.as_deref().map(Cow::Borrowed).ok_or_else(|| {
+                    DataError::file(
+                        path,
+                        "glTF buffer refers to the GLB binary chunk, which is missing",
+                    )
+                })?
+            }
             gltf::buffer::Source::Uri(uri) => load_uri(path, folder, uri, files)?,
         };
         if data.len() < buffer.length() {
@@ -85,8 +100,13 @@ fn load_buffers(
     Ok(out)
 }
 
-/// Bytes of a glTF URI: a `data:...;base64,` URI or a file relative to the glTF's folder.
-fn load_uri(path: &str, folder: &str, uri: &str, files: &FileSet) -> Result<Vec<u8>, DataError> {
+/// Bytes of a glTF URI: a `data:...;base64,` URI or a file relative to the glTF's folder (borrowed).
+fn load_uri<'a>(
+    path: &str,
+    folder: &str,
+    uri: &str,
+    files: &'a FileSet,
+) -> Result<Cow<'a, [u8]>, DataError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((_, payload)) = rest.split_once(";base64,") else {
             return Err(DataError::file(
@@ -95,6 +115,7 @@ fn load_uri(path: &str, folder: &str, uri: &str, files: &FileSet) -> Result<Vec<
             ));
         };
         return decode_base64(payload)
+            .map(Cow::Owned)
             .ok_or_else(|| DataError::file(path, "glTF data URI holds invalid base64"));
     }
     let key = join_relative(folder, &percent_decode(uri)).ok_or_else(|| {
@@ -103,12 +124,15 @@ fn load_uri(path: &str, folder: &str, uri: &str, files: &FileSet) -> Result<Vec<
             format!("glTF URI '{uri}' is absolute or leaves the dataset; expected a relative path"),
         )
     })?;
-    files.get(&key).cloned().ok_or_else(|| {
-        DataError::file(
-            path,
-            format!("glTF refers to '{key}', which is not in the dataset"),
-        )
-    })
+    files
+        .get(&key)
+        .map(|b| Cow::Borrowed(&b[..]))
+        .ok_or_else(|| {
+            DataError::file(
+                path,
+                format!("glTF refers to '{key}', which is not in the dataset"),
+            )
+        })
 }
 
 /// Decodes `%XX` escapes in a URI (invalid escapes are kept as written).
@@ -170,10 +194,14 @@ struct GltfReader<'a> {
     path: &'a str,
     folder: &'a str,
     gltf: &'a gltf::Gltf,
-    buffers: Vec<Vec<u8>>,
+    buffers: Vec<Cow<'a, [u8]>>,
     files: &'a FileSet,
-    /// Decoded images by index (`None`: could not decode, already warned).
-    images: HashMap<usize, Option<Arc<RgbaImage>>>,
+    textures: &'a mut Textures,
+    /// Each mesh's primitives in the mesh's own frame, read on its first instance.
+    meshes: HashMap<usize, Arc<[RenderMesh]>>,
+    /// Node instances and triangles so far, against [`MAX_NODE_INSTANCES`] and [`MAX_GLTF_TRIANGLES`].
+    instances: usize,
+    triangles: usize,
     out: Vec<RenderMesh>,
 }
 
@@ -191,6 +219,15 @@ impl GltfReader<'_> {
                 format!("glTF nodes nested deeper than {MAX_NODE_DEPTH} (a cycle?)"),
             ));
         }
+        self.instances += 1;
+        if self.instances > MAX_NODE_INSTANCES {
+            return Err(DataError::file(
+                self.path,
+                format!(
+                    "the scene expands to more than {MAX_NODE_INSTANCES} node instances (a node listed by several parents is repeated once per path to it); expected a scene tree of real size"
+                ),
+            ));
+        }
         let world = parent * Mat4::from_cols_array_2d(&node.transform().matrix());
         if let Some(mesh) = node.mesh() {
             self.mesh(&mesh, &Affine3A::from_mat4(world), warnings)?;
@@ -201,12 +238,43 @@ impl GltfReader<'_> {
         Ok(())
     }
 
+    /// Places one instance of `mesh` (read on first use) in the scene.
     fn mesh(
         &mut self,
         mesh: &gltf::Mesh<'_>,
         transform: &Affine3A,
         warnings: &mut Vec<String>,
     ) -> Result<(), DataError> {
+        let local = match self.meshes.get(&mesh.index()) {
+            Some(m) => m.clone(),
+            None => {
+                let m: Arc<[RenderMesh]> = self.read_mesh(mesh, warnings)?.into();
+                self.meshes.insert(mesh.index(), m.clone());
+                m
+            }
+        };
+        self.triangles += local.iter().map(|m| m.indices.len()).sum::<usize>();
+        if self.triangles > MAX_GLTF_TRIANGLES {
+            return Err(DataError::file(
+                self.path,
+                format!(
+                    "the scene instances more than {MAX_GLTF_TRIANGLES} triangles (mesh {} is one of them); simplify the mesh first",
+                    mesh.index()
+                ),
+            ));
+        }
+        self.out
+            .extend(local.iter().map(|m| m.transformed(transform)));
+        Ok(())
+    }
+
+    /// A mesh's triangle primitives in its own frame.
+    fn read_mesh(
+        &mut self,
+        mesh: &gltf::Mesh<'_>,
+        warnings: &mut Vec<String>,
+    ) -> Result<Vec<RenderMesh>, DataError> {
+        let mut out = Vec::new();
         for prim in mesh.primitives() {
             let what = format!("mesh {} primitive {}", mesh.index(), prim.index());
             if prim.mode() != gltf::mesh::Mode::Triangles {
@@ -272,17 +340,16 @@ impl GltfReader<'_> {
                 }
                 None => None,
             };
-            let local = RenderMesh {
+            out.push(RenderMesh {
                 positions,
                 normals,
                 uvs,
                 colors,
                 indices,
                 material,
-            };
-            self.out.push(local.transformed(transform));
+            });
         }
-        Ok(())
+        Ok(out)
     }
 
     /// The primitive's material and the texture-coordinate set its base-colour texture uses.
@@ -313,48 +380,37 @@ impl GltfReader<'_> {
         )
     }
 
+    /// Image `index`, decoded once per import: an external file is shared with every other
+    /// image, material and mesh file of the object that names it.
     fn image(&mut self, index: usize, warnings: &mut Vec<String>) -> Option<Arc<RgbaImage>> {
-        if let Some(cached) = self.images.get(&index) {
-            return cached.clone();
-        }
-        let decoded = self.decode_image(index, warnings).map(Arc::new);
-        self.images.insert(index, decoded.clone());
-        decoded
-    }
-
-    fn decode_image(&self, index: usize, warnings: &mut Vec<String>) -> Option<RgbaImage> {
         // Read the JSON directly: `gltf::Image::source` unwraps an optional MIME type that validation does not check.
         let json = self.gltf.as_json().images.get(index)?;
         let label = format!("{} image {index}", self.path);
-        let bytes: Vec<u8> = if let Some(view) = &json.buffer_view {
-            let view = self.gltf.views().nth(view.value())?;
-            match self.view_bytes(&view) {
-                Some(b) => b.to_vec(),
-                None => {
-                    warnings.push(format!(
-                        "{label}: buffer view out of range; using the base colour"
-                    ));
-                    return None;
-                }
+        if let Some(view) = &json.buffer_view {
+            let bytes = self
+                .gltf
+                .views()
+                .nth(view.value())
+                .and_then(|v| view_bytes(&self.buffers, &v));
+            if bytes.is_none() {
+                warnings.push(format!(
+                    "{label}: buffer view out of range; using the base colour"
+                ));
             }
-        } else if let Some(uri) = &json.uri {
-            match load_uri(self.path, self.folder, uri, self.files) {
-                Ok(b) => b,
-                Err(e) => {
-                    warnings.push(format!("{e}; using the base colour"));
-                    return None;
-                }
-            }
-        } else {
-            return None;
+            let key = format!("{label} (buffer view {})", view.value());
+            return self
+                .textures
+                .get(&key, || bytes.map(Cow::Borrowed), warnings);
+        }
+        let uri = json.uri.as_deref()?;
+        let key = match join_relative(self.folder, &percent_decode(uri)) {
+            Some(file) if !uri.starts_with("data:") => file,
+            _ => label,
         };
-        decode_texture(&label, &bytes, warnings)
-    }
-
-    fn view_bytes(&self, view: &gltf::buffer::View<'_>) -> Option<&[u8]> {
-        let data = self.buffers.get(view.buffer().index())?;
-        let end = view.offset().checked_add(view.length())?;
-        data.get(view.offset()..end)
+        let bytes = load_uri(self.path, self.folder, uri, self.files)
+            .map_err(|e| warnings.push(format!("{e}; using the base colour")))
+            .ok();
+        self.textures.get(&key, || bytes, warnings)
     }
 
     /// Reads a float accessor with `comps` components per element (normalized integers scaled to [0, 1] / [−1, 1]).
@@ -441,8 +497,7 @@ impl GltfReader<'_> {
                 "accessor without a buffer view is not supported".into(),
             ));
         };
-        let data = self
-            .view_bytes(&view)
+        let data = view_bytes(&self.buffers, &view)
             .ok_or_else(|| self.err(what, "buffer view lies outside its buffer".into()))?;
         let stride = view.stride().unwrap_or(elem).max(elem);
         let last = match count.checked_sub(1) {
@@ -473,4 +528,11 @@ impl GltfReader<'_> {
     fn err(&self, what: &str, message: String) -> DataError {
         DataError::field(self.path, what, message)
     }
+}
+
+/// The bytes of a buffer view, if it lies inside its buffer.
+fn view_bytes<'b>(buffers: &'b [Cow<'_, [u8]>], view: &gltf::buffer::View<'_>) -> Option<&'b [u8]> {
+    let data = buffers.get(view.buffer().index())?;
+    let end = view.offset().checked_add(view.length())?;
+    data.get(view.offset()..end)
 }

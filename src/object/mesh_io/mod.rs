@@ -13,7 +13,7 @@ mod stl;
 use crate::data::{DataError, FileSet};
 
 use super::RenderMesh;
-pub(super) use shared::{decode_texture, join_relative};
+pub(crate) use shared::{Textures, join_relative};
 
 /// Mesh file formats the importer reads.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -51,6 +51,17 @@ pub fn load_mesh(
     files: &FileSet,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
+    load_mesh_with(path, files, &mut Textures::default(), warnings)
+}
+
+/// [`load_mesh`] within one import: textures already decoded for the object are shared, and its
+/// texture budget applies.
+pub(crate) fn load_mesh_with(
+    path: &str,
+    files: &FileSet,
+    textures: &mut Textures,
+    warnings: &mut Vec<String>,
+) -> Result<Vec<RenderMesh>, DataError> {
     let Some(format) = MeshFormat::from_path(path) else {
         let ext = path
             .rsplit('/')
@@ -68,9 +79,11 @@ pub fn load_mesh(
         return Err(DataError::file(path, "mesh file not found in the dataset"));
     };
     let meshes = match format {
-        MeshFormat::Obj => obj::read_obj(path, bytes, files, warnings)?,
+        MeshFormat::Obj => obj::read_obj(path, bytes, files, textures, warnings)?,
         MeshFormat::Stl => stl::read_stl(path, bytes)?,
-        MeshFormat::Glb | MeshFormat::Gltf => gltf::read_gltf(path, bytes, files, warnings)?,
+        MeshFormat::Glb | MeshFormat::Gltf => {
+            gltf::read_gltf(path, bytes, files, textures, warnings)?
+        }
     };
     if meshes.iter().all(|m| m.indices.is_empty()) {
         return Err(DataError::file(path, "mesh file holds no triangles"));

@@ -2,20 +2,22 @@
 //! OBJ's `v` texture coordinate is flipped so that `v = 0` is the top row, as in glTF.
 
 use std::io::{BufReader, Cursor};
-use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 
 use crate::data::{DataError, FileSet};
 use crate::object::{Material, RenderMesh};
 
-use super::shared::{folder_of, join_relative, load_texture_file, triangles, vertex_normals};
+use super::shared::{
+    Textures, folder_of, join_relative, load_texture_file, triangles, vertex_normals,
+};
 
 /// Reads an OBJ file and the MTL library and textures it names (looked up in `files` next to it).
 pub(super) fn read_obj(
     path: &str,
     bytes: &[u8],
     files: &FileSet,
+    textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
     let folder = folder_of(path);
@@ -56,7 +58,8 @@ pub(super) fn read_obj(
     let materials = materials.unwrap_or_default();
     let tex_folder = mtl_folder.into_inner();
 
-    // Decode each material once, even when many groups use it.
+    // Each material once, even when many groups use it; each texture once, even when many
+    // materials name it.
     let mut decoded: Vec<Material> = Vec::with_capacity(materials.len());
     for m in &materials {
         let d = m.diffuse.unwrap_or([0.7, 0.7, 0.7]);
@@ -64,7 +67,7 @@ pub(super) fn read_obj(
         let texture = m
             .diffuse_texture
             .as_deref()
-            .and_then(|t| load_texture_file(path, &tex_folder, t, files, warnings).map(Arc::new));
+            .and_then(|t| load_texture_file(path, &tex_folder, t, files, textures, warnings));
         decoded.push(Material {
             name: Some(m.name.clone()),
             base_color: [d[0], d[1], d[2], alpha],

@@ -1,9 +1,69 @@
 //! Helpers shared by the mesh readers: paths inside the file set, checked triangle lists, vertex normals and
-//! PNG textures.
+//! PNG textures (decoded once per import, under a budget).
+
+use std::borrow::Cow;
+use std::collections::HashMap;
+use std::sync::Arc;
 
 use glam::Vec3;
 
 use crate::data::{DataError, FileSet, RgbaImage};
+
+/// Pixels all the textures of one import may decode to (1 GiB of RGBA): past it a texture is
+/// skipped with a warning, as an unreadable one is.
+pub(crate) const MAX_TEXTURE_PIXELS: u64 = 1 << 28;
+
+/// The textures of one import (an object's URDF and every mesh file it names), decoded once per
+/// file however many materials name it.
+#[derive(Default)]
+pub(crate) struct Textures {
+    decoded: HashMap<String, Option<Arc<RgbaImage>>>,
+    pixels: u64,
+}
+
+impl Textures {
+    /// The texture `key` (a file key, or a label unique within the import) decoded from `bytes`,
+    /// or the one decoded earlier under that key; `None` (with a warning) when it cannot be used.
+    pub(crate) fn get<'b>(
+        &mut self,
+        key: &str,
+        bytes: impl FnOnce() -> Option<Cow<'b, [u8]>>,
+        warnings: &mut Vec<String>,
+    ) -> Option<Arc<RgbaImage>> {
+        if let Some(cached) = self.decoded.get(key) {
+            return cached.clone();
+        }
+        let decoded = bytes().and_then(|b| self.decode_within_budget(key, &b, warnings));
+        self.decoded.insert(key.to_string(), decoded.clone());
+        decoded
+    }
+
+    fn decode_within_budget(
+        &mut self,
+        key: &str,
+        bytes: &[u8],
+        warnings: &mut Vec<String>,
+    ) -> Option<Arc<RgbaImage>> {
+        // The header's size, before decoding: a few kilobytes of PNG can claim gigapixels.
+        let claimed = match bytes.get(12..24) {
+            Some(h) if &h[..4] == b"IHDR" => {
+                let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
+                be(&h[4..8]) * be(&h[8..12])
+            }
+            _ => 0,
+        };
+        if self.pixels.saturating_add(claimed) > MAX_TEXTURE_PIXELS {
+            warnings.push(format!(
+                "{key}: texture of {claimed} pixels would take this object's textures past {} MB decoded; using the base colour",
+                (4 * MAX_TEXTURE_PIXELS) >> 20
+            ));
+            return None;
+        }
+        let image = decode_texture(key, bytes, warnings)?;
+        self.pixels += u64::from(image.width) * u64::from(image.height);
+        Some(Arc::new(image))
+    }
+}
 
 /// Folder part of a '/'-separated path, with a trailing '/' (empty for a top-level file).
 pub(super) fn folder_of(path: &str) -> &str {
@@ -73,14 +133,16 @@ pub(super) fn vertex_normals(positions: &[Vec3], indices: &[[u32; 3]]) -> Vec<Ve
     normals.iter().map(|n| n.normalize_or_zero()).collect()
 }
 
-/// Loads a texture referenced by `referrer`; PNG is decoded, anything else becomes a warning and `None`.
+/// Loads a texture referenced by `referrer`; PNG is decoded (once per import), anything else becomes
+/// a warning and `None`.
 pub(super) fn load_texture_file(
     referrer: &str,
     folder: &str,
     name: &str,
     files: &FileSet,
+    textures: &mut Textures,
     warnings: &mut Vec<String>,
-) -> Option<RgbaImage> {
+) -> Option<Arc<RgbaImage>> {
     let Some(key) = join_relative(folder, name) else {
         warnings.push(format!(
             "{referrer}: texture '{name}' is outside the dataset; using the base colour"
@@ -93,7 +155,7 @@ pub(super) fn load_texture_file(
         ));
         return None;
     };
-    decode_texture(&key, bytes, warnings)
+    textures.get(&key, || Some(Cow::Borrowed(bytes)), warnings)
 }
 
 /// Decodes PNG texture bytes to RGBA; other formats (JPEG: no decoder in this build) give a warning.

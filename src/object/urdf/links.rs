@@ -1,6 +1,7 @@
 //! Link contents: `<visual>` / `<collision>` elements, their geometry (box, cylinder, sphere, mesh files
 //! loaded once and shared) and materials (inline or robot-level, with optional PNG texture).
 
+use std::borrow::Cow;
 use std::sync::Arc;
 
 use glam::Vec3;
@@ -11,6 +12,10 @@ use crate::object::mesh_io::{self, MeshFormat};
 use crate::object::{Geometry, Material, RenderMesh, Visual};
 
 use super::reader::{Reader, child};
+
+/// Triangles an imported object may hold over all its visuals and collisions, a mesh counted once
+/// per use (20 M: about 1 GB of vertex data; scanned parts have a few hundred thousand).
+pub const MAX_OBJECT_TRIANGLES: usize = 20_000_000;
 
 impl Reader<'_, '_> {
     /// A `<visual>` or `<collision>` element (collisions keep no material).
@@ -115,23 +120,40 @@ impl Reader<'_, '_> {
         let meshes = match self.meshes.get(&key) {
             Some(m) => m.clone(),
             None => {
-                let loaded: Arc<[RenderMesh]> =
-                    match mesh_io::load_mesh(&key, self.files, &mut self.warnings) {
-                        Ok(m) => m.into(),
-                        Err(mut e) => {
-                            // The mesh file is at fault; say where the URDF refers to it.
-                            let line = self.doc.text_pos_at(node.range().start).row;
-                            e.message = format!(
-                                "{} (mesh of {} at {path}, line {line})",
-                                e.message, self.file
-                            );
-                            return Err(e);
-                        }
-                    };
+                let loaded: Arc<[RenderMesh]> = match mesh_io::load_mesh_with(
+                    &key,
+                    self.files,
+                    &mut self.textures,
+                    &mut self.warnings,
+                ) {
+                    Ok(m) => m.into(),
+                    Err(mut e) => {
+                        // The mesh file is at fault; say where the URDF refers to it.
+                        let line = self.doc.text_pos_at(node.range().start).row;
+                        e.message = format!(
+                            "{} (mesh of {} at {path}, line {line})",
+                            e.message, self.file
+                        );
+                        return Err(e);
+                    }
+                };
                 self.meshes.insert(key.clone(), loaded.clone());
                 loaded
             }
         };
+        // Shared meshes cost nothing to read but are drawn once per use: a few links naming a
+        // large file many times would make an object no capture can hold.
+        self.triangles += meshes.iter().map(|m| m.indices.len()).sum::<usize>();
+        if self.triangles > MAX_OBJECT_TRIANGLES {
+            return Err(self.err(
+                node,
+                path,
+                Some("filename"),
+                format!(
+                    "with '{key}' the object's visuals and collisions reach more than {MAX_OBJECT_TRIANGLES} triangles; simplify its meshes first"
+                ),
+            ));
+        }
         Ok(Geometry::Mesh {
             path: key,
             scale,
@@ -192,7 +214,8 @@ impl Reader<'_, '_> {
             match self.files.get(&key) {
                 Some(bytes) => {
                     material.texture =
-                        mesh_io::decode_texture(&key, bytes, &mut self.warnings).map(Arc::new);
+                        self.textures
+                            .get(&key, || Some(Cow::Borrowed(bytes)), &mut self.warnings);
                 }
                 None => self.warnings.push(format!(
                     "{}: {tpath}: texture '{key}' not found; using the colour",

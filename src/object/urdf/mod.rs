@@ -20,6 +20,7 @@ use std::collections::HashMap;
 
 use crate::data::{DataError, FileSet};
 
+use super::mesh_io::Textures;
 use super::{ArticulatedObject, Joint, Link};
 use reader::{Reader, children};
 
@@ -43,6 +44,8 @@ pub(super) fn read_urdf(urdf_path: &str, files: &FileSet) -> Result<ArticulatedO
         },
         packages: None,
         meshes: HashMap::new(),
+        textures: Textures::default(),
+        triangles: 0,
         materials: HashMap::new(),
         warnings: Vec::new(),
     };

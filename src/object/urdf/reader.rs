@@ -7,6 +7,7 @@ use std::sync::Arc;
 use roxmltree::Node;
 
 use crate::data::FileSet;
+use crate::object::mesh_io::Textures;
 use crate::object::{Material, RenderMesh};
 
 /// Child elements of `node` named `tag`.
@@ -39,6 +40,10 @@ pub(super) struct Reader<'a, 'input> {
     pub(super) packages: Option<HashMap<String, Vec<String>>>,
     /// Loaded mesh files by key, shared between visuals.
     pub(super) meshes: HashMap<String, Arc<[RenderMesh]>>,
+    /// Textures decoded so far, shared by every material and mesh file of the object.
+    pub(super) textures: Textures,
+    /// Triangles of the visuals and collisions read so far (a mesh counts once per use).
+    pub(super) triangles: usize,
     /// Robot-level materials by name.
     pub(super) materials: HashMap<String, Material>,
     pub(super) warnings: Vec<String>,
