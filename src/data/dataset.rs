@@ -178,10 +178,11 @@ impl GroundTruth {
     }
 
     /// Writes `gt/trans.json` and the meshes (binary PLY) in the layout [`GroundTruth::from_files`] reads.
-    pub fn to_files(&self) -> FileSet {
+    /// Refuses (naming the file) a joint or vertex that is not a finite number.
+    pub fn to_files(&self) -> Result<FileSet, DataError> {
         let mut out = FileSet::new();
-        write_ground_truth(self.joints.as_deref(), &self.meshes, &mut out);
-        out
+        write_ground_truth(self.joints.as_deref(), &self.meshes, &mut out)?;
+        Ok(out)
     }
 }
 

@@ -9,6 +9,7 @@ use serde_json::{Value, json};
 
 use super::FileSet;
 use super::error::{DataError, Errors};
+use super::finite::{ensure_finite, point_values};
 use super::json::{Json, f32_array, f32_value, join};
 use super::ply::{PlyFormat, TriMesh};
 use super::{GT_TRANS_PATH, State};
@@ -246,17 +247,28 @@ pub(crate) fn write_ground_truth(
     joints: Option<&[GtJoint]>,
     meshes: &[Option<GtMeshes>; 2],
     out: &mut FileSet,
-) {
+) -> Result<(), DataError> {
     if let Some(joints) = joints {
+        for (i, j) in joints.iter().enumerate() {
+            let values = point_values(&[j.origin, j.direction])
+                .chain([j.start, j.end])
+                .collect::<Vec<_>>();
+            ensure_finite(GT_TRANS_PATH, &format!("trans_info[{i}]"), values)?;
+        }
         out.insert(GT_TRANS_PATH.into(), write_trans(joints));
     }
     for state in State::ALL {
         if let Some(m) = &meshes[state.index()] {
-            let ply = |mesh: &TriMesh| mesh.to_ply(PlyFormat::BinaryLittleEndian);
-            out.insert(static_mesh_path(state), ply(&m.static_part));
+            let mut ply = |path: String, mesh: &TriMesh| -> Result<(), DataError> {
+                ensure_finite(&path, "vertex", point_values(&mesh.positions))?;
+                out.insert(path, mesh.to_ply(PlyFormat::BinaryLittleEndian));
+                Ok(())
+            };
+            ply(static_mesh_path(state), &m.static_part)?;
             for (i, mesh) in m.movable.iter().enumerate() {
-                out.insert(movable_mesh_path(state, i), ply(mesh));
+                ply(movable_mesh_path(state, i), mesh)?;
             }
         }
     }
+    Ok(())
 }

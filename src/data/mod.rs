@@ -20,6 +20,7 @@ mod camera;
 mod dataset;
 pub mod degrade;
 mod error;
+pub mod finite;
 pub mod fixture;
 mod frame;
 #[cfg(not(target_arch = "wasm32"))]

@@ -7,6 +7,7 @@
 use std::collections::{BTreeMap, BTreeSet};
 
 use super::error::DataError;
+use super::finite::{ensure_finite, matrix_values};
 use super::frame::{Frame, size_error};
 use super::gt::{GtJoint, GtMeshes, implied_num_parts, write_ground_truth};
 use super::image_io;
@@ -98,6 +99,13 @@ impl DatasetWriter {
         }
         let rgba_path = transforms::frame_path(state, split, "rgba", &frame.name, ".png");
         let k = &frame.camera.intrinsics;
+        let pose = matrix_values(&frame.camera.camera_to_world);
+        ensure_finite(&file, &format!("{field}.transform_matrix"), pose)?;
+        ensure_finite(
+            &file,
+            &format!("{field} intrinsics"),
+            [k.fx, k.fy, k.cx, k.cy],
+        )?;
         if size != log.size || (k.width, k.height) != size {
             return Err(size_error(
                 &rgba_path,
@@ -207,7 +215,7 @@ impl DatasetWriter {
                 transforms::write(*state, *split, &log.frames),
             );
         }
-        write_ground_truth(gt_joints, gt_meshes, &mut out);
+        write_ground_truth(gt_joints, gt_meshes, &mut out)?;
         Ok(out)
     }
 }

@@ -119,7 +119,13 @@ impl FitFolder {
                 id: id.to_string(),
                 source,
             })?;
-        let mut files = fit.as_ground_truth().to_files();
+        let mut files = fit
+            .as_ground_truth()
+            .to_files()
+            .map_err(|source| FolderError::Export {
+                id: id.to_string(),
+                source,
+            })?;
         files.insert(JOINTS_FILE.into(), joints_json);
         files.insert(REPORT_FILE.into(), json(&report, REPORT_FILE)?.into_bytes());
         files.extend(exports.into_fit_folder());

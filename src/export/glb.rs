@@ -38,6 +38,7 @@ pub fn write_glb(
     end: &[f32],
     file: &str,
 ) -> Result<Vec<u8>, DataError> {
+    super::ensure_exportable(obj, &[start, end], file)?;
     let start = obj.apply_mimic(start);
     let end = obj.apply_mimic(end);
     let mut b = Builder::default();

@@ -14,6 +14,7 @@
 //! Like the rest of the core, bytes in and bytes out: the browser app downloads what these return.
 
 pub mod archive;
+pub mod finite;
 pub mod folder;
 pub mod glb;
 pub mod inertia;
@@ -22,6 +23,7 @@ pub mod twin;
 pub mod urdf;
 
 pub use archive::write_zip;
+pub use finite::ensure_exportable;
 pub use folder::{FitFolder, FolderError, REPORT_FILE};
 pub use glb::write_glb;
 pub use joints::{GeometryRecord, JointRecord, joint_records};
@@ -108,11 +110,20 @@ pub fn end_configuration(
                 format!("no joint named {name:?} in the URDF"),
             )
         })?;
+        // A finite f64 past f32's range (1e300) would become infinity here.
         let motion = record["motion"]
             .as_f64()
-            .filter(|m| m.is_finite())
-            .ok_or_else(|| DataError::field(file, field("motion"), "expected a finite number"))?
-            as f32;
+            .filter(|m| m.abs() <= f64::from(f32::MAX))
+            .ok_or_else(|| {
+                DataError::field(
+                    file,
+                    field("motion"),
+                    format!(
+                        "expected a finite number (degrees or metres), found {}",
+                        record["motion"]
+                    ),
+                )
+            })? as f32;
         let kind = record["type"].as_str().unwrap_or_default();
         end[j] = match (kind, object.joints[j].kind) {
             ("revolute", JointKind::Revolute | JointKind::Continuous) => motion.to_radians(),

@@ -25,6 +25,7 @@ use crate::object::{ArticulatedObject, Geometry, JointKind, Material, RenderMesh
 /// Writes `obj` as `urdf_name` (e.g. `object.urdf` or `object/model.urdf`) plus `meshes/…` files in the URDF's
 /// folder, which the URDF references relatively.
 pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, DataError> {
+    super::ensure_exportable(obj, &[&obj.rest_configuration()], urdf_name)?;
     let folder = urdf_name.rfind('/').map_or("", |i| &urdf_name[..=i]);
     let mut files = FileSet::new();
     let mut names = UniqueNames::default();

@@ -110,7 +110,7 @@ fn eval_scores_ground_truth_as_zero_and_a_tilted_axis_by_its_angle() {
     let tilt_axis = joint.direction.any_orthonormal_vector();
     joint.direction = Quat::from_axis_angle(tilt_axis, 10f32.to_radians()) * joint.direction;
     let pred_dir = tmp.join("prediction");
-    data::write_dir(&pred.to_files(), Path::new(&pred_dir)).unwrap();
+    data::write_dir(&pred.to_files().unwrap(), Path::new(&pred_dir)).unwrap();
 
     let scored = json(&artmesh(&["eval", &pred_dir, &gt_dir, "--samples", "2000"]));
     let axis_ang = scored["joints"][0]["axis_ang"].as_f64().unwrap();

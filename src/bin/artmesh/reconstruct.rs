@@ -77,7 +77,10 @@ fn reconstruct(
         &dataset.gt_meshes,
         &eval::ChamferOptions::default(),
     );
-    let mut files = reconstruction.as_ground_truth().to_files();
+    let mut files = reconstruction
+        .as_ground_truth()
+        .to_files()
+        .map_err(|e| e.to_string())?;
     files.insert("report.json".into(), to_json(&report)?.into_bytes());
     data::write_dir(&files, out).map_err(|e| e.to_string())?;
     log_report(&report);
