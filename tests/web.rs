@@ -7,6 +7,9 @@ use wasm_bindgen_test::*;
 
 wasm_bindgen_test_configure!(run_in_browser);
 
+#[path = "web/readers.rs"]
+mod readers;
+
 async fn context() -> GpuContext {
     match GpuContext::new().await {
         Ok(ctx) => ctx,

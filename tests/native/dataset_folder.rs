@@ -45,56 +45,6 @@ fn only_the_referenced_files_are_read() {
     let _ = std::fs::remove_dir_all(&dir);
 }
 
-/// Transforms files for both states whose `frames` all name `path`.
-fn frames_naming(path: &str, frames: usize) -> data::FileSet {
-    let frame = format!(
-        r#"{{"file_path": "{path}", "transform_matrix": [[1,0,0,0],[0,1,0,0],[0,0,1,2],[0,0,0,1]]}}"#
-    );
-    let json = format!(
-        r#"{{"camera_angle_x": 0.8, "frames": [{}]}}"#,
-        vec![frame; frames].join(",")
-    );
-    let mut files = data::FileSet::new();
-    for state in ["start", "end"] {
-        files.insert(
-            format!("transforms_train_{state}.json"),
-            json.clone().into_bytes(),
-        );
-    }
-    files
-}
-
-#[test]
-fn one_small_image_named_by_700_frames_is_refused_before_decoding() {
-    // 2048² RGBA of zeros: ~50 KB of PNG, 16.8 MB decoded, 11.7 GB for 700 frames a state.
-    let zeros = vec![0u8; 4 * 2048 * 2048];
-    let png = data::encode_png("big.png", 2048, 2048, data::PngPixels::Rgba8(&zeros)).unwrap();
-    assert!(png.len() < 100_000);
-    let mut files = frames_naming("rgba/big", 700);
-    files.insert("rgba/big.png".into(), png);
-    let t = std::time::Instant::now();
-    let errors = data::Dataset::from_files(&files).unwrap_err();
-    assert!(
-        t.elapsed().as_secs_f64() < 5.0,
-        "refused only after decoding"
-    );
-    let first = errors.0[0].to_string();
-    assert!(
-        first.starts_with("transforms_train_start.json: its 700 frames' images decode to 11744 MB")
-            && first.contains("over the budget of 8590 MB")
-            && first.contains("--max-decoded-mb"),
-        "{errors}"
-    );
-    // A PNG header claiming 100 000² pixels (a few bytes) is refused the same way.
-    let mut bomb = data::encode_png("x.png", 1, 1, data::PngPixels::Rgba8(&[0; 4])).unwrap();
-    bomb[16..20].copy_from_slice(&100_000u32.to_be_bytes());
-    bomb[20..24].copy_from_slice(&100_000u32.to_be_bytes());
-    let mut files = frames_naming("rgba/bomb", 1);
-    files.insert("rgba/bomb.png".into(), bomb);
-    let errors = data::Dataset::from_files(&files).unwrap_err();
-    assert!(errors.to_string().contains("over the budget"), "{errors}");
-}
-
 #[test]
 fn the_budget_is_a_flag() {
     let dir = std::env::temp_dir().join(format!("artmesh-dataset-budget-{}", std::process::id()));
