@@ -7,6 +7,8 @@ use wasm_bindgen_test::*;
 
 wasm_bindgen_test_configure!(run_in_browser);
 
+#[path = "web/budgets.rs"]
+mod budgets;
 #[path = "web/readers.rs"]
 mod readers;
 

@@ -1,11 +1,14 @@
-// The Input section's dataset half: reads a dropped or picked folder or .zip into a wasm Dataset,
-// shows its summary and thumbnails, or the readers' problems. `document.body.dataset.dataset`
-// becomes "ok" or "problems" (tests wait on it).
+// The Input section's dataset half: reads a dropped or picked folder or .zip into a wasm Dataset
+// (of a folder only the files the dataset needs; a folder or .zip past the page's budgets is
+// refused before it is read), shows its summary and thumbnails, or the readers' problems.
+// `document.body.dataset.dataset` becomes "ok" or "problems" (tests wait on it).
 import { $, errorText, drawRgba, freeQuietly } from "./util.js";
 
 let Dataset = null;
 let hooks = { onDataset: () => {}, onProblems: () => {} };
 let loadToken = 0;
+// The page's budgets (Dataset.file_limits()); set in setupInput.
+let limits = { max_listed_files: Infinity, max_zip_bytes: Infinity };
 
 const isZip = (name) => /\.zip$/i.test(name);
 
@@ -13,13 +16,15 @@ function entryFile(entry) {
   return new Promise((resolve, reject) => entry.file(resolve, reject));
 }
 
-// Walks a FileSystemEntry tree; paths include the entry's own name ("folder/sub/file").
+// Walks a FileSystemEntry tree; paths include the entry's own name ("folder/sub/file"). Stops
+// once past the page's file limit: wasm then refuses the folder by its count.
 async function readEntry(entry, prefix, out) {
+  if (out.length > limits.max_listed_files) return;
   if (entry.isFile) {
     out.push([prefix + entry.name, await entryFile(entry)]);
   } else if (entry.isDirectory) {
     const reader = entry.createReader();
-    for (;;) {
+    while (out.length <= limits.max_listed_files) {
       const batch = await new Promise((resolve, reject) => reader.readEntries(resolve, reject));
       if (batch.length === 0) break;
       for (const child of batch) await readEntry(child, prefix + entry.name + "/", out);
@@ -27,15 +32,10 @@ async function readEntry(entry, prefix, out) {
   }
 }
 
-// Paths relative to the dropped folder: when every path starts with the same folder, drop it.
-function stripRoot(paths) {
-  if (paths.length === 0 || !paths.every((p) => p.includes("/"))) return paths;
-  const root = paths[0].split("/")[0];
-  if (!paths.every((p) => p.split("/")[0] === root)) return paths;
-  return paths.map((p) => p.slice(root.length + 1));
-}
+const mb = (bytes) => `${Math.round(bytes / 1e6)} MB`;
 
-const hidden = (path) => path.split("/").some((part) => part.startsWith(".") || part === "");
+// The dropped folder's name for errors: the first path's top folder.
+const folderName = (paths) => (paths[0]?.includes("/") ? paths[0].split("/")[0] : "the dropped files");
 
 function status(text) {
   const out = $("dataset-result");
@@ -88,23 +88,49 @@ export function showDataset(ds) {
   document.body.dataset.dataset = "ok";
 }
 
+// Reads `paths` of the dropped files `byPath`; null once a newer load has begun.
+async function readFiles(paths, byPath, token) {
+  const contents = [];
+  for (const [i, path] of paths.entries()) {
+    if (i % 20 === 0) status(`Reading files: ${i} of ${paths.length}…`);
+    try {
+      contents.push(new Uint8Array(await byPath.get(path).arrayBuffer()));
+    } catch (e) {
+      throw new Error(`${path}: cannot read: ${errorText(e)}`);
+    }
+    if (token !== loadToken) return null;
+  }
+  return contents;
+}
+
+// A dropped folder: wasm picks the files the dataset needs from the paths and sizes (the
+// transforms files and gt/ first, then the images they name) and only those are read, so an
+// unrelated video beside the dataset is never loaded. Hidden files and an enclosing folder are
+// wasm's to skip too.
 async function loadFiles(pairs) {
   const token = ++loadToken;
-  const stripped = stripRoot(pairs.map(([path]) => path));
-  const keep = [];
-  stripped.forEach((path, i) => { if (!hidden(path)) keep.push([path, pairs[i][1]]); });
-  if (keep.length === 0) { problems("No files found (hidden files are skipped)."); return; }
-  const paths = [], contents = [];
-  for (const [i, [path, file]] of keep.entries()) {
-    if (i % 20 === 0) status(`Reading files: ${i} of ${keep.length}…`);
-    paths.push(path);
-    contents.push(new Uint8Array(await file.arrayBuffer()));
-    if (token !== loadToken) return;
+  if (pairs.length === 0) { problems("No files found in what was dropped."); return; }
+  const paths = pairs.map(([path]) => path);
+  const byPath = new Map(pairs);
+  const sizes = Float64Array.from(pairs, ([, file]) => file.size);
+  const folder = folderName(paths);
+  const read = [], contents = [];
+  try {
+    for (let round = 0; round < 2; round++) {
+      const wanted = Dataset.files_needed(folder, paths, sizes, read, contents);
+      const got = await readFiles(wanted, byPath, token);
+      if (!got) return;
+      read.push(...wanted);
+      contents.push(...got);
+    }
+  } catch (e) {
+    if (token === loadToken) problems(errorText(e));
+    return;
   }
-  status(`Checking ${keep.length} files…`);
+  status(`Checking ${read.length} files…`);
   let ds;
   try {
-    ds = Dataset.from_files(paths, contents);
+    ds = Dataset.from_files(read, contents);
   } catch (e) {
     if (token === loadToken) problems(errorText(e));
     return;
@@ -115,6 +141,11 @@ async function loadFiles(pairs) {
 
 async function loadZip(file) {
   const token = ++loadToken;
+  if (file.size > limits.max_zip_bytes) {
+    problems(`${file.name}: the archive takes ${mb(file.size)}, more than the ${mb(limits.max_zip_bytes)} ` +
+      "the page reads of a .zip; unzip it and drop the folder instead (only the dataset's own files are then read)");
+    return;
+  }
   status(`Reading ${file.name}…`);
   const bytes = new Uint8Array(await file.arrayBuffer());
   if (token !== loadToken) return;
@@ -150,6 +181,7 @@ async function loadDropped(entries, files) {
 export function setupInput(DatasetClass, { onDataset, onProblems }) {
   Dataset = DatasetClass;
   hooks = { onDataset, onProblems };
+  limits = JSON.parse(Dataset.file_limits());
   const zone = $("dropzone");
   for (const type of ["dragenter", "dragover"]) {
     zone.addEventListener(type, (e) => { e.preventDefault(); zone.classList.add("over"); });

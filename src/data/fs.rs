@@ -1,12 +1,13 @@
 //! Native-only bridge between a folder on disk and a [`FileSet`]. Never overwrites anything.
 
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 use std::fs;
-use std::io::Write;
+use std::io::{Read, Write};
 use std::path::{Component, Path, PathBuf};
 
-use super::error::{DataError, DatasetErrors, Errors};
-use super::{FileSet, Split, State};
+use super::FileSet;
+use super::archive::{FileLimits, Listing};
+use super::error::{DataError, DatasetErrors};
 
 /// Why [`read_dataset`] found no valid dataset.
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
@@ -36,59 +37,32 @@ pub fn read_dataset(root: &Path) -> Result<super::Dataset, ReadDatasetError> {
 
 /// The files of the dataset folder `root` that a dataset is made of, and nothing else: the
 /// transforms files, `gt/`, and the images the transforms files refer to (with their depth and
-/// semantic siblings). An unrelated video beside the frames, a name that is not UTF-8 or a
-/// dangling symlink elsewhere in the folder is never read and never an error.
+/// semantic siblings), chosen as for an archive ([`Listing`]). An unrelated video beside the
+/// frames, a name that is not UTF-8 or a dangling symlink elsewhere in the folder is never read
+/// and never an error. Refuses a folder past the default [`FileLimits`].
 pub fn read_dataset_files(root: &Path) -> Result<FileSet, DataError> {
-    let mut listing = Listing::new();
-    list(&folder(root)?, "", 0, Strictness::Lenient, &mut listing)?;
-    // First what names the rest: the transforms files and the ground truth.
-    let mut files = FileSet::new();
-    for (rel, path) in &listing {
-        if super::is_dataset_index(rel) {
-            read_into(rel, path, &mut files)?;
-        }
-    }
-    for rel in referenced_paths(&files) {
-        if let Some(path) = listing.get(&rel) {
-            read_into(&rel, path, &mut files)?;
-        }
-    }
-    Ok(files)
-}
-
-/// Every path the transforms files in `files` refer to, with each image's depth and semantic
-/// siblings under every name the reader tries: what a reader of a folder needs to read besides
-/// the transforms files and `gt/`. Malformed transforms files contribute what they can; their
-/// errors are the reader's to report.
-fn referenced_paths(files: &FileSet) -> BTreeSet<String> {
-    let mut wanted = BTreeSet::new();
-    for state in State::ALL {
-        for split in Split::ALL {
-            let file = super::transforms_file_name(split, state);
-            let Some(bytes) = files.get(&file) else {
-                continue;
-            };
-            let Some(spec) = super::transforms::parse(&file, bytes, &mut Errors::default()) else {
-                continue;
-            };
-            for fs in &spec.frames {
-                for image in super::paths::image_candidates(&fs.file_path) {
-                    for (kind, exts) in super::paths::SIBLINGS {
-                        wanted.extend(
-                            exts.iter()
-                                .filter_map(|e| super::paths::sibling(&image, kind, e)),
-                        );
-                    }
-                    wanted.insert(image);
-                }
-            }
-        }
-    }
-    wanted
+    let mut found = Found::new();
+    list(&folder(root)?, "", 0, Strictness::Lenient, &mut found)?;
+    let sizes = found
+        .iter()
+        .map(|(rel, (_, size))| (rel.clone(), *size))
+        .collect();
+    let listing = Listing::new(&root.display().to_string(), sizes, FileLimits::default())?;
+    listing.read(|rel, at_most| {
+        let cannot = |e: std::io::Error| DataError::file(rel, format!("cannot read: {e}"));
+        let (path, _) = found
+            .get(rel)
+            .ok_or_else(|| cannot(std::io::ErrorKind::NotFound.into()))?;
+        let mut bytes = Vec::new();
+        fs::File::open(path)
+            .and_then(|f| f.take(at_most.saturating_add(1)).read_to_end(&mut bytes))
+            .map_err(cannot)?;
+        Ok(bytes)
+    })
 }
 
 /// `root` as a folder to read, or why it is not one.
-fn folder(root: &Path) -> Result<PathBuf, DataError> {
+pub(super) fn folder(root: &Path) -> Result<PathBuf, DataError> {
     let shown = root.display().to_string();
     let meta = fs::metadata(root)
         .map_err(|e| DataError::file(&shown, format!("cannot open the dataset folder: {e}")))?;
@@ -101,12 +75,12 @@ fn folder(root: &Path) -> Result<PathBuf, DataError> {
     Ok(root.to_path_buf())
 }
 
-/// Non-hidden files below a folder, by `'/'`-separated relative path.
-type Listing = BTreeMap<String, PathBuf>;
+/// Non-hidden files below a folder, by `'/'`-separated relative path: where each is and its size.
+pub(super) type Found = BTreeMap<String, (PathBuf, u64)>;
 
 /// What [`list`] does with an entry it cannot use.
 #[derive(Clone, Copy, PartialEq)]
-enum Strictness {
+pub(super) enum Strictness {
     /// A name that is not UTF-8 or an entry that cannot be inspected (a dangling symlink) is an
     /// error: [`read_dir`] reads everything, so it must be able to name everything.
     Strict,
@@ -116,12 +90,12 @@ enum Strictness {
 
 /// Lists the non-hidden files below `dir` without reading them. Follows symlinks, so linked
 /// folders and files are listed like real ones.
-fn list(
+pub(super) fn list(
     dir: &Path,
     prefix: &str,
     depth: usize,
     strictness: Strictness,
-    out: &mut Listing,
+    out: &mut Found,
 ) -> Result<(), DataError> {
     let shown = if prefix.is_empty() { "." } else { prefix };
     if depth > MAX_DEPTH {
@@ -161,7 +135,7 @@ fn list(
         match fs::metadata(&path) {
             Ok(meta) if meta.is_dir() => list(&path, &rel, depth + 1, strictness, out)?,
             Ok(meta) if meta.is_file() => {
-                out.insert(rel, path);
+                out.insert(rel, (path, meta.len()));
             }
             Ok(_) => {}
             Err(e) if strict => return Err(DataError::file(&rel, format!("cannot read: {e}"))),
@@ -171,24 +145,19 @@ fn list(
     Ok(())
 }
 
-/// Reads the file at `path` into `files` under `rel`.
-fn read_into(rel: &str, path: &Path, files: &mut FileSet) -> Result<(), DataError> {
-    let bytes = fs::read(path).map_err(|e| DataError::file(rel, format!("cannot read: {e}")))?;
-    files.insert(rel.to_string(), bytes);
-    Ok(())
-}
-
 /// Folders nested deeper than this are not followed (guards against symlink loops).
 const MAX_DEPTH: usize = 32;
 
 /// Reads every non-hidden file below `root` into a [`FileSet`] keyed by `'/'`-separated relative path.
 /// Hidden files and folders (name starting with `.`) are skipped. Read-only.
 pub fn read_dir(root: &Path) -> Result<FileSet, DataError> {
-    let mut listing = Listing::new();
-    list(&folder(root)?, "", 0, Strictness::Strict, &mut listing)?;
+    let mut found = Found::new();
+    list(&folder(root)?, "", 0, Strictness::Strict, &mut found)?;
     let mut files = FileSet::new();
-    for (rel, path) in &listing {
-        read_into(rel, path, &mut files)?;
+    for (rel, (path, _)) in &found {
+        let bytes =
+            fs::read(path).map_err(|e| DataError::file(rel, format!("cannot read: {e}")))?;
+        files.insert(rel.clone(), bytes);
     }
     Ok(files)
 }

@@ -39,7 +39,7 @@ mod writer;
 
 use std::collections::BTreeMap;
 
-pub use archive::read_zip;
+pub use archive::{FileLimits, Listing, dataset_paths, read_zip, read_zip_within};
 pub use camera::{Camera, Intrinsics, look_at};
 pub use dataset::{Dataset, GroundTruth};
 pub use error::{DataError, DatasetErrors};
@@ -143,7 +143,6 @@ pub(crate) fn transforms_file_name(split: Split, state: State) -> String {
 
 /// Whether a dataset path is one that names the others or stands alone: a transforms file at the
 /// root, or anything under `gt/`.
-#[cfg(not(target_arch = "wasm32"))]
 pub(crate) fn is_dataset_index(rel: &str) -> bool {
     rel.starts_with("gt/")
         || State::ALL

@@ -1,6 +1,7 @@
 //! The wasm-bindgen surface for `web/` (the page's API is written up in `web/API.md`): the
 //! adapter report and GPU self-test, dataset loading and the demo capture, the fit with progress
-//! events and pause/cancel ([`app`]), each preset's budget and the page's overrides of it
+//! events and pause/cancel ([`app`]), which files of a dropped folder to read and the page's file
+//! budgets (`files`), each preset's budget and the page's overrides of it
 //! (`budget`), and the result viewer ([`viewer`]).
 //! Structured results cross the boundary as JSON strings or plain objects; images as
 //! `Uint8ClampedArray` RGBA.
@@ -11,6 +12,7 @@
 
 pub mod app;
 mod budget;
+mod files;
 pub mod viewer;
 
 use std::cell::RefCell;

@@ -5,12 +5,13 @@
 //  4. a joint slider changes the viewer's picture;
 //  5. downloads: the GLB passes the glTF validator, the zip holds <folder>/twin.urdf with joint limits;
 //  6. a malformed dataset, as a folder and as a dropped .zip, is reported by file name;
+//     budgets: a zip bomb is refused, a folder beside a 4 GB file loads without reading it;
 //  7. no request leaves the page's origin.
 // Screenshots go to artefacts/ (repository root). Exit code 0 = pass. Needs web/pkg built (web/build.sh)
 // and the native CLI (ARTMESH_BIN, default target/debug/artmesh).
 import { chromium } from "playwright-core";
 import validator from "gltf-validator";
-import { mkdir, mkdtemp, writeFile, cp, readFile } from "node:fs/promises";
+import { mkdir, mkdtemp, writeFile, cp, readFile, truncate } from "node:fs/promises";
 import { execFileSync } from "node:child_process";
 import { tmpdir } from "node:os";
 import { join } from "node:path";
@@ -345,6 +346,45 @@ try {
     check((await body()).dataset === "problems" && text.includes("end/train/rgba/0001.png"),
       `truncated PNG in a dropped .zip (${bytes.length} bytes) reported by name: ${text.split("\n")[1] ?? text}`);
     await page.screenshot({ path: artefacts + "web-dataset-error.png", fullPage: true });
+  });
+
+  await step("budgets", async () => {
+    // 1.2 GB of zeros in gt/ (read whole, so needed) packed into 5 MB: past the page's 1 GiB.
+    const bomb = join(work, "bomb.zip");
+    const py = [
+      "import sys, zipfile",
+      "zeros = bytes(1 << 20)",
+      "with zipfile.ZipFile(sys.argv[1], 'w', zipfile.ZIP_DEFLATED, compresslevel=1) as z:",
+      "    z.writestr('bomb/transforms_train_start.json', '{}')",
+      "    for i in range(12):",
+      "        with z.open(f'bomb/gt/zeros{i}.bin', 'w') as f:",
+      "            for _ in range(100): f.write(zeros)",
+    ].join("\n");
+    execFileSync("python3", ["-c", py, bomb], { stdio: ["ignore", "ignore", "inherit"] });
+    await clearFlags("dataset");
+    const t0 = performance.now();
+    await page.setInputFiles("#zipfile", bomb);
+    await page.waitForFunction(() => document.body.dataset.dataset, null, { timeout: 60_000 });
+    const text = await page.locator("#dataset-result").textContent();
+    check((await body()).dataset === "problems" && text.includes("bomb.zip") && text.includes("over the budget"),
+      `a zip bomb is refused in ${((performance.now() - t0) / 1000).toFixed(1)} s: ${text}`);
+
+    // The sample dataset beside a sparse 4 GB recording, which must not be read.
+    const big = join(work, "beside-4gb");
+    await cp(join(work, "good"), big, { recursive: true });
+    await writeFile(join(big, "capture.mp4"), "");
+    await truncate(join(big, "capture.mp4"), 4 * 2 ** 30);
+    await page.evaluate(() => {
+      window.artmeshRead = [];
+      const read = Blob.prototype.arrayBuffer;
+      Blob.prototype.arrayBuffer = function () { window.artmeshRead.push(this.name); return read.call(this); };
+    });
+    await clearFlags("dataset");
+    await page.setInputFiles("#folder", big);
+    await page.waitForFunction(() => document.body.dataset.dataset, null, { timeout: 60_000 });
+    const read = await page.evaluate(() => window.artmeshRead);
+    check((await body()).dataset === "ok" && read.length > 0 && !read.includes("capture.mp4"),
+      `after the bomb, a dataset beside a 4 GB file loads reading ${read.length} files, not the 4 GB one`);
   });
 
   // 7. nothing leaves the page -------------------------------------------------------------
