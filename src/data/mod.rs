@@ -28,6 +28,8 @@ mod fs;
 mod gt;
 mod image_io;
 mod json;
+#[cfg(not(target_arch = "wasm32"))]
+mod lazy_folder;
 mod npy;
 mod parallel;
 mod paths;
@@ -48,6 +50,8 @@ pub use frame::Frame;
 pub use fs::{ReadDatasetError, read_dataset, read_dataset_files, read_dir, write_dir};
 pub use gt::{GtJoint, GtMeshes, JointKind};
 pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png};
+#[cfg(not(target_arch = "wasm32"))]
+pub use lazy_folder::LazyFolder;
 pub use npy::encode_npy;
 pub use paths::rebase_on_dataset_root;
 pub use ply::{PlyFormat, TriMesh};
@@ -57,6 +61,25 @@ pub use writer::{DatasetWriter, SemanticFormat, WriteOptions};
 
 /// A dataset as bytes: relative path (`'/'` separators, e.g. `start/train/rgba/0000.png`) → file contents.
 pub type FileSet = BTreeMap<String, Vec<u8>>;
+
+/// Files by relative path (`'/'` separators) that a reader asks for one at a time: a [`FileSet`]
+/// held in memory, or a folder read on demand, so that only what is asked for is ever read.
+pub trait FileSource {
+    /// The bytes of `path`, or `None` when there is no such (readable) file.
+    fn file(&self, path: &str) -> Option<&[u8]>;
+    /// Every path present, in order, without reading any.
+    fn paths(&self) -> Vec<&str>;
+}
+
+impl FileSource for FileSet {
+    fn file(&self, path: &str) -> Option<&[u8]> {
+        self.get(path).map(Vec::as_slice)
+    }
+
+    fn paths(&self) -> Vec<&str> {
+        self.keys().map(String::as_str).collect()
+    }
+}
 
 /// Articulation state of the object.
 #[derive(

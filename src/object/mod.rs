@@ -2,7 +2,7 @@
 //!
 //! An [`ArticulatedObject`] is what a URDF describes: a tree of [`Link`]s (each with visual and collision
 //! geometry) connected by [`Joint`]s (fixed, revolute, continuous, prismatic). It is read from bytes with
-//! [`ArticulatedObject::from_urdf`] (URDF + OBJ/MTL, STL, GLB/glTF meshes, all taken from a [`FileSet`]),
+//! [`ArticulatedObject::from_urdf`] (URDF + OBJ/MTL, STL, GLB/glTF meshes, all taken from a [`FileSource`](crate::data::FileSource)),
 //! posed with [`ArticulatedObject::forward_kinematics`], and grouped into rigid **parts** with
 //! [`ArticulatedObject::parts`]: the unit the ArtMesh pipeline reconstructs (part 0 = static base, one part
 //! per movable joint).
@@ -38,7 +38,7 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Vec2, Vec3};
 
-use crate::data::{DataError, FileSet, RgbaImage};
+use crate::data::{DataError, FileSource, RgbaImage};
 
 pub use kinematics::part_joint;
 pub use mesh_io::{MeshFormat, load_mesh};
@@ -164,7 +164,7 @@ pub enum Geometry {
     },
     /// Mesh file, loaded.
     Mesh {
-        /// Key of the mesh file in the [`FileSet`] (after `package://` and relative-path resolution).
+        /// Key of the mesh file in the [`FileSource`] (after `package://` and relative-path resolution).
         path: String,
         /// Per-axis scale from the URDF (applied by [`Visual::link_frame_meshes`], not baked into `meshes`).
         scale: Vec3,
@@ -344,8 +344,11 @@ pub struct ArticulatedObject {
 impl ArticulatedObject {
     /// Reads a URDF and the meshes it references. `urdf_path` is a key of `files`; relative mesh paths resolve
     /// against the URDF's folder, `package://NAME/rest` against the folder of the `package.xml` whose `<name>`
-    /// is `NAME`. `file://` and absolute paths, and paths leaving the [`FileSet`] root, are errors.
-    pub fn from_urdf(urdf_path: &str, files: &FileSet) -> Result<ArticulatedObject, DataError> {
+    /// is `NAME`. `file://` and absolute paths, and paths leaving the [`FileSource`]'s root, are errors.
+    pub fn from_urdf(
+        urdf_path: &str,
+        files: &dyn FileSource,
+    ) -> Result<ArticulatedObject, DataError> {
         urdf::read_urdf(urdf_path, files)
     }
 

@@ -86,49 +86,45 @@ impl GtRenderer {
         })
     }
 
-    /// Uploads geometry and materials; one draw per non-empty mesh. Each distinct texture image is uploaded once.
+    /// Uploads geometry and materials: one draw per part and texture, however many meshes share
+    /// them (a glTF scene can instance one small mesh 100 000 times, and a draw each would take
+    /// minutes a view). Each distinct texture image is uploaded once.
     fn upload_meshes(&self, ctx: &GpuContext, meshes: &[PartMesh]) -> GpuResult<Vec<MeshDraw>> {
         let device = &ctx.device;
         let mut textures: HashMap<*const RgbaImage, wgpu::TextureView> = HashMap::new();
         let mut draws = Vec::new();
-        for (i, pm) in meshes.iter().enumerate() {
-            let m = &pm.mesh;
-            if m.indices.is_empty() {
-                continue;
-            }
-            let vertices = vertices_of(i, m)?;
-            let index_count = m.indices.len() as u64 * 3;
-            let vbytes = vertices.len() as u64 * size_of::<Vertex>() as u64;
+        for batch in batches(meshes)? {
+            let index_count = batch.indices.len() as u64;
+            let vbytes = batch.vertices.len() as u64 * size_of::<Vertex>() as u64;
             let ibytes = index_count * 4;
             let max = ctx.limits.max_buffer_size;
             if vbytes > max || ibytes > max || index_count > u32::MAX as u64 {
                 return Err(GpuError::TooManyElements {
-                    what: format!("mesh {i}: vertex or index buffer (bytes)"),
+                    what: format!("part {}: vertex or index buffer (bytes)", batch.part),
                     count: vbytes.max(ibytes),
                     max,
                 });
             }
             let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("render_gt vertices"),
-                contents: bytemuck::cast_slice(&vertices),
+                contents: bytemuck::cast_slice(&batch.vertices),
                 usage: wgpu::BufferUsages::VERTEX,
             });
             let index_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
                 label: Some("render_gt indices"),
-                contents: bytemuck::cast_slice(&m.indices),
+                contents: bytemuck::cast_slice(&batch.indices),
                 usage: wgpu::BufferUsages::INDEX,
             });
-            let textured = m.material.texture.is_some() && m.uvs.is_some();
-            let view = match (&m.material.texture, textured) {
-                (Some(tex), true) => match textures.entry(Arc::as_ptr(tex)) {
+            let view = match batch.texture {
+                Some(tex) => match textures.entry(Arc::as_ptr(tex)) {
                     Entry::Occupied(e) => &*e.into_mut(),
                     Entry::Vacant(e) => &*e.insert(upload_texture(ctx, tex)?),
                 },
-                _ => &self.white,
+                None => &self.white,
             };
             let params = MeshParams {
-                part: pm.part.into(),
-                textured: textured as u32,
+                part: batch.part.into(),
+                textured: batch.texture.is_some() as u32,
                 _pad: [0; 2],
             };
             let params_buffer = ctx.uniform_buffer("render_gt mesh", &params);
@@ -314,6 +310,48 @@ impl GtRenderer {
 }
 
 /// Interleaved vertices of mesh `i`; errors on indices past the end. Missing or short normals/uvs become zero.
+/// The meshes of one part that share a texture (or have none), as one vertex and index list.
+struct Batch<'a> {
+    part: i16,
+    texture: Option<&'a Arc<RgbaImage>>,
+    vertices: Vec<Vertex>,
+    indices: Vec<u32>,
+}
+
+/// The non-empty meshes merged into one [`Batch`] per part and texture, in order of first use.
+/// A texture on a mesh without uvs is ignored.
+fn batches(meshes: &[PartMesh]) -> GpuResult<Vec<Batch<'_>>> {
+    let mut out: Vec<Batch> = Vec::new();
+    let mut slot: HashMap<(i16, Option<*const RgbaImage>), usize> = HashMap::new();
+    for (i, pm) in meshes.iter().enumerate() {
+        let m = &pm.mesh;
+        if m.indices.is_empty() {
+            continue;
+        }
+        let texture = m.material.texture.as_ref().filter(|_| m.uvs.is_some());
+        let key = (pm.part, texture.map(Arc::as_ptr));
+        let k = *slot.entry(key).or_insert_with(|| {
+            out.push(Batch {
+                part: pm.part,
+                texture,
+                vertices: Vec::new(),
+                indices: Vec::new(),
+            });
+            out.len() - 1
+        });
+        let batch = &mut out[k];
+        let base = u32::try_from(batch.vertices.len())
+            .ok()
+            .filter(|b| b.checked_add(m.positions.len() as u32).is_some())
+            .ok_or_else(|| invalid(format!("part {}: more than 2³² vertices", pm.part)))?;
+        batch.vertices.extend(vertices_of(i, m)?);
+        batch
+            .indices
+            .extend(m.indices.iter().flatten().map(|&v| base + v));
+    }
+    Ok(out)
+}
+
 fn vertices_of(i: usize, m: &RenderMesh) -> GpuResult<Vec<Vertex>> {
     let n = m.positions.len();
     if let Some(bad) = m.indices.iter().flatten().find(|&&v| v as usize >= n) {

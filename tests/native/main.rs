@@ -29,3 +29,4 @@ mod raster;
 mod reconstruct;
 mod render_gt;
 mod synth_objects;
+mod urdf_folder;

@@ -27,16 +27,16 @@ pub struct SuiteObjects {
 /// How objects are captured (defaults: the paper's Articulate-100 setting).
 #[derive(clap::Args)]
 pub struct CaptureArgs {
-    /// Image width in pixels [default: 800; 64 with --quick].
+    /// Image width in pixels [default: 800; 64 for `suite --quick`].
     #[arg(long, value_parser = clap::value_parser!(u32).range(8..=8192))]
     width: Option<u32>,
-    /// Image height in pixels [default: 800; 64 with --quick].
+    /// Image height in pixels [default: 800; 64 for `suite --quick`].
     #[arg(long, value_parser = clap::value_parser!(u32).range(8..=8192))]
     height: Option<u32>,
-    /// Train views per state [default: 100; 6 with --quick].
+    /// Train views per state [default: 100; 6 for `suite --quick`].
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=10_000))]
     train_views: Option<u32>,
-    /// Test views per state [default: 20; 2 with --quick].
+    /// Test views per state [default: 20; 2 for `suite --quick`].
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=10_000))]
     test_views: Option<u32>,
     /// Horizontal field of view in degrees.

@@ -16,23 +16,24 @@ pub fn write_object(object: &ArticulatedObject, folder: &Path) -> Result<(), Str
     data::write_dir(&files, folder).map_err(|e| format!("{}: {e}", folder.display()))
 }
 
-/// Imports a URDF, reading the nearest enclosing folder with a `package.xml` (for `package://` paths), or the
-/// URDF's own folder.
+/// Imports a URDF from the nearest enclosing folder with a `package.xml` (for `package://` paths),
+/// or the URDF's own folder, reading only the files the URDF and its meshes refer to.
 pub fn read_urdf(urdf: &Path) -> Result<ArticulatedObject, String> {
     if !urdf.is_file() {
         return Err(format!("{}: no such file", urdf.display()));
     }
-    let folder = urdf
-        .parent()
-        .filter(|p| !p.as_os_str().is_empty())
-        .unwrap_or(Path::new("."));
+    // Absolute, so that a bare `robot.urdf` has a folder and every ancestor is a real one.
+    let urdf = urdf
+        .canonicalize()
+        .map_err(|e| format!("{}: {e}", urdf.display()))?;
+    let folder = urdf.parent().unwrap_or(Path::new("/"));
     let root: PathBuf = folder
         .ancestors()
         .take(4)
         .find(|a| a.join("package.xml").is_file())
         .unwrap_or(folder)
         .to_path_buf();
-    let files = data::read_dir(&root).map_err(|e| format!("{}: {e}", root.display()))?;
+    let files = data::LazyFolder::list(&root).map_err(|e| format!("{}: {e}", root.display()))?;
     let key = urdf
         .strip_prefix(&root)
         .map_err(|_| format!("{} is not inside {}", urdf.display(), root.display()))?

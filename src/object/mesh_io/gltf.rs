@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec2, Vec3};
 
-use crate::data::{DataError, FileSet, RgbaImage};
+use crate::data::{DataError, FileSource, RgbaImage};
 use crate::object::{Material, RenderMesh};
 
 use super::shared::{Textures, folder_of, join_relative, triangles, vertex_normals};
@@ -26,7 +26,7 @@ pub(crate) const MAX_GLTF_TRIANGLES: usize = 20_000_000;
 pub(super) fn read_gltf(
     path: &str,
     bytes: &[u8],
-    files: &FileSet,
+    files: &dyn FileSource,
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
@@ -69,7 +69,7 @@ fn load_buffers<'a>(
     path: &str,
     folder: &str,
     gltf: &'a gltf::Gltf,
-    files: &'a FileSet,
+    files: &'a dyn FileSource,
 ) -> Result<Vec<Cow<'a, [u8]>>, DataError> {
     let mut out = Vec::new();
     for buffer in gltf.buffers() {
@@ -105,7 +105,7 @@ fn load_uri<'a>(
     path: &str,
     folder: &str,
     uri: &str,
-    files: &'a FileSet,
+    files: &'a dyn FileSource,
 ) -> Result<Cow<'a, [u8]>, DataError> {
     if let Some(rest) = uri.strip_prefix("data:") {
         let Some((_, payload)) = rest.split_once(";base64,") else {
@@ -124,15 +124,12 @@ fn load_uri<'a>(
             format!("glTF URI '{uri}' is absolute or leaves the dataset; expected a relative path"),
         )
     })?;
-    files
-        .get(&key)
-        .map(|b| Cow::Borrowed(&b[..]))
-        .ok_or_else(|| {
-            DataError::file(
-                path,
-                format!("glTF refers to '{key}', which is not in the dataset"),
-            )
-        })
+    files.file(&key).map(Cow::Borrowed).ok_or_else(|| {
+        DataError::file(
+            path,
+            format!("glTF refers to '{key}', which is not in the dataset"),
+        )
+    })
 }
 
 /// Decodes `%XX` escapes in a URI (invalid escapes are kept as written).
@@ -195,7 +192,7 @@ struct GltfReader<'a> {
     folder: &'a str,
     gltf: &'a gltf::Gltf,
     buffers: Vec<Cow<'a, [u8]>>,
-    files: &'a FileSet,
+    files: &'a dyn FileSource,
     textures: &'a mut Textures,
     /// Each mesh's primitives in the mesh's own frame, read on its first instance.
     meshes: HashMap<usize, Arc<[RenderMesh]>>,

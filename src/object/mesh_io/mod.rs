@@ -10,7 +10,7 @@ mod obj;
 mod shared;
 mod stl;
 
-use crate::data::{DataError, FileSet};
+use crate::data::{DataError, FileSource};
 
 use super::RenderMesh;
 pub(crate) use shared::{Textures, join_relative};
@@ -48,7 +48,7 @@ impl MeshFormat {
 /// `warnings`. Errors name `path` (or the referenced file at fault).
 pub fn load_mesh(
     path: &str,
-    files: &FileSet,
+    files: &dyn FileSource,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
     load_mesh_with(path, files, &mut Textures::default(), warnings)
@@ -58,7 +58,7 @@ pub fn load_mesh(
 /// texture budget applies.
 pub(crate) fn load_mesh_with(
     path: &str,
-    files: &FileSet,
+    files: &dyn FileSource,
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
@@ -75,7 +75,7 @@ pub(crate) fn load_mesh_with(
             ),
         ));
     };
-    let Some(bytes) = files.get(path) else {
+    let Some(bytes) = files.file(path) else {
         return Err(DataError::file(path, "mesh file not found in the dataset"));
     };
     let meshes = match format {
@@ -100,6 +100,7 @@ mod tests {
     use super::gltf::{decode_base64, percent_decode};
     use super::stl::read_stl;
     use super::*;
+    use crate::data::FileSet;
 
     #[test]
     fn object_join_relative_stays_inside() {

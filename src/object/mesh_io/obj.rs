@@ -5,7 +5,7 @@ use std::io::{BufReader, Cursor};
 
 use glam::{Vec2, Vec3};
 
-use crate::data::{DataError, FileSet};
+use crate::data::{DataError, FileSource};
 use crate::object::{Material, RenderMesh};
 
 use super::shared::{
@@ -16,7 +16,7 @@ use super::shared::{
 pub(super) fn read_obj(
     path: &str,
     bytes: &[u8],
-    files: &FileSet,
+    files: &dyn FileSource,
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
@@ -38,7 +38,7 @@ pub(super) fn read_obj(
             ));
             return Err(tobj::LoadError::OpenFileFailed);
         };
-        let Some(data) = files.get(&key) else {
+        let Some(data) = files.file(&key) else {
             notes.borrow_mut().push(format!(
                 "{path}: material library '{key}' not found; using plain colours"
             ));

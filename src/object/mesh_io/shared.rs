@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use crate::data::{DataError, FileSet, RgbaImage};
+use crate::data::{DataError, FileSource, RgbaImage};
 
 /// Pixels all the textures of one import may decode to (1 GiB of RGBA): past it a texture is
 /// skipped with a warning, as an unreadable one is.
@@ -139,7 +139,7 @@ pub(super) fn load_texture_file(
     referrer: &str,
     folder: &str,
     name: &str,
-    files: &FileSet,
+    files: &dyn FileSource,
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Option<Arc<RgbaImage>> {
@@ -149,7 +149,7 @@ pub(super) fn load_texture_file(
         ));
         return None;
     };
-    let Some(bytes) = files.get(&key) else {
+    let Some(bytes) = files.file(&key) else {
         warnings.push(format!(
             "{referrer}: texture '{key}' not found; using the base colour"
         ));

@@ -109,7 +109,7 @@ impl Reader<'_, '_> {
                 ),
             ));
         }
-        if !self.files.contains_key(&key) {
+        if self.files.file(&key).is_none() {
             return Err(self.err(
                 node,
                 path,
@@ -211,7 +211,7 @@ impl Reader<'_, '_> {
         {
             let tpath = format!("{path}/texture");
             let key = self.resolve(filename, t, &tpath)?;
-            match self.files.get(&key) {
+            match self.files.file(&key) {
                 Some(bytes) => {
                     material.texture =
                         self.textures

@@ -18,16 +18,19 @@ mod resolve;
 
 use std::collections::HashMap;
 
-use crate::data::{DataError, FileSet};
+use crate::data::{DataError, FileSource};
 
 use super::mesh_io::Textures;
 use super::{ArticulatedObject, Joint, Link};
 use reader::{Reader, children};
 
 /// Reads the URDF `urdf_path` of `files` and every mesh and texture it refers to.
-pub(super) fn read_urdf(urdf_path: &str, files: &FileSet) -> Result<ArticulatedObject, DataError> {
+pub(super) fn read_urdf(
+    urdf_path: &str,
+    files: &dyn FileSource,
+) -> Result<ArticulatedObject, DataError> {
     let bytes = files
-        .get(urdf_path)
+        .file(urdf_path)
         .ok_or_else(|| DataError::file(urdf_path, "URDF file not found in the dataset"))?;
     let text = std::str::from_utf8(bytes)
         .map_err(|e| DataError::file(urdf_path, format!("URDF is not valid UTF-8: {e}")))?;
@@ -123,6 +126,7 @@ mod tests {
     use glam::Vec3;
 
     use super::*;
+    use crate::data::FileSet;
 
     fn files(urdf: &str) -> FileSet {
         let mut f = FileSet::new();

@@ -6,7 +6,7 @@ use std::sync::Arc;
 
 use roxmltree::Node;
 
-use crate::data::FileSet;
+use crate::data::FileSource;
 use crate::object::mesh_io::Textures;
 use crate::object::{Material, RenderMesh};
 
@@ -33,7 +33,7 @@ pub(super) fn child<'a, 'input>(
 pub(super) struct Reader<'a, 'input> {
     pub(super) file: &'a str,
     pub(super) doc: &'a roxmltree::Document<'input>,
-    pub(super) files: &'a FileSet,
+    pub(super) files: &'a dyn FileSource,
     /// The URDF's folder, with a trailing '/' (empty at the top level).
     pub(super) folder: &'a str,
     /// package name → folder (with trailing '/'), read from `package.xml` files on first use.

@@ -5,7 +5,7 @@ use std::collections::HashMap;
 
 use roxmltree::Node;
 
-use crate::data::{DataError, FileSet};
+use crate::data::{DataError, FileSource};
 use crate::object::mesh_io::join_relative;
 
 use super::reader::{Reader, child};
@@ -104,14 +104,17 @@ impl Reader<'_, '_> {
 }
 
 /// package name → folders (with trailing '/') of every `package.xml` in the file set that names it.
-fn find_packages(files: &FileSet) -> HashMap<String, Vec<String>> {
+fn find_packages(files: &dyn FileSource) -> HashMap<String, Vec<String>> {
     let mut out: HashMap<String, Vec<String>> = HashMap::new();
-    for (key, bytes) in files {
+    for key in files.paths() {
         let folder = if key == "package.xml" {
             ""
         } else if let Some(f) = key.strip_suffix("/package.xml") {
             f
         } else {
+            continue;
+        };
+        let Some(bytes) = files.file(key) else {
             continue;
         };
         let Ok(text) = std::str::from_utf8(bytes) else {
