@@ -169,3 +169,44 @@ fn info_and_fit_name_what_a_fit_would_refuse() {
     );
     assert!(!Path::new(&tmp.join("fit")).exists());
 }
+
+#[test]
+fn render_refuses_links_and_full_folders_and_leaves_nothing_when_it_fails() {
+    let tmp = TempDir::new("outputs-render");
+    let object = tmp.join("object");
+    let run = artmesh(&with_small_capture(
+        &["synth", "--category", "storage", "--out", &tmp.join("s")],
+        "0",
+    ));
+    assert!(run.status.success(), "{}", text(&run.stderr));
+    std::fs::rename(tmp.0.join("s/object"), &object).unwrap();
+    let urdf = std::fs::read_dir(&object)
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .find(|p| p.extension().is_some_and(|x| x == "urdf"))
+        .unwrap()
+        .display()
+        .to_string();
+    let render = |out: &str, range: &str| -> Vec<String> {
+        let args = ["render", &urdf, "--start-range", range, "--out", out];
+        with_small_capture(&args, "0")
+            .into_iter()
+            .map(str::to_string)
+            .collect()
+    };
+    let refused_render = |out: &str, range: &str, says: &str| {
+        let args = render(out, range);
+        refused(&args.iter().map(String::as_str).collect::<Vec<_>>(), says);
+    };
+    let dangling = tmp.join("dangling");
+    std::os::unix::fs::symlink(tmp.0.join("gone"), &dangling).unwrap();
+    refused_render(&dangling, "0.6,0.8", "is a symlink");
+    std::fs::create_dir_all(tmp.0.join("full")).unwrap();
+    std::fs::write(tmp.0.join("full/keep.txt"), "mine").unwrap();
+    refused_render(&tmp.join("full"), "0.6,0.8", "not empty");
+    assert_eq!(names(&tmp.0.join("full")), ["keep.txt"]);
+    // A range outside [0, 1] is refused by the capture; no folder (nor its parents) stays.
+    refused_render(&tmp.join("a/b/out"), "0.5,1.5", "range");
+    assert!(!tmp.0.join("a").exists(), "{:?}", names(&tmp.0));
+    assert!(!tmp.0.join("gone").exists());
+}
