@@ -17,6 +17,7 @@ mod eval_metrics;
 mod eval_metrics_objects;
 mod export;
 mod fit_photometric;
+mod fuzz;
 mod gpu_primitives;
 mod layering;
 mod loss_optim;
