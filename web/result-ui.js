@@ -226,7 +226,21 @@ const DOWNLOADS = {
   "download-zip": ["twin.zip", "application/zip"],
   "download-joints": ["joints.json", "application/json"],
   "download-report": ["report.json", "application/json"],
+  "download-preview": ["preview.png", "image/png"],
 };
+
+let previewUrl = null;
+
+/** Shows `preview.png` of the result (hidden when there is none). */
+function showPreview(fitResult) {
+  if (previewUrl) URL.revokeObjectURL(previewUrl);
+  previewUrl = null;
+  try {
+    previewUrl = URL.createObjectURL(new Blob([fitResult.file("preview.png")], { type: "image/png" }));
+    $("preview").src = previewUrl;
+  } catch (e) { console.error("preview:", e); }
+  $("preview-box").hidden = previewUrl === null;
+}
 
 function download(name, type) {
   if (!result) return;
@@ -285,6 +299,7 @@ export async function showResult(ViewerClass, fitResult) {
   fillMetrics(report.metrics ?? null);
   fillJoints(joints);
   fillWarnings(report.warnings);
+  showPreview(fitResult);
 
   // A fresh canvas per result: a canvas keeps the context it was first configured with.
   const fresh = document.createElement("canvas");

@@ -6,6 +6,7 @@
 
 pub mod check;
 pub mod demo;
+pub mod preview;
 
 use std::fmt;
 
@@ -86,7 +87,8 @@ pub struct FitRun {
 
 /// Fits `input` with `config` (reconstruction of both states, then articulation; `observer` hears
 /// both and may pause or cancel them), then scores the fit against the dataset's ground truth
-/// when it has one and builds the output folder ([`FitFolder::build`]).
+/// when it has one and builds the output folder ([`FitFolder::build`], and
+/// [`preview::PREVIEW_FILE`]).
 pub async fn fit_and_export(
     ctx: &GpuContext,
     input: &FitInput,
@@ -101,7 +103,7 @@ pub async fn fit_and_export(
             source,
         })?;
     let seconds = now_seconds() - t0;
-    let folder = FitFolder::build(
+    let mut folder = FitFolder::build(
         &fit,
         &input.dataset,
         config,
@@ -110,6 +112,8 @@ pub async fn fit_and_export(
         seconds,
     )
     .map_err(|e| PipelineError::Export(e.to_string()))?;
+    let png = preview::preview_png(ctx, &input.dataset, &folder.twin).await?;
+    folder.files.insert(preview::PREVIEW_FILE.into(), png);
     Ok(FitRun {
         fit,
         folder,

@@ -21,6 +21,7 @@
 
 mod dataset;
 mod pipeline;
+mod preview;
 mod sheet;
 mod view;
 pub mod viewer;
@@ -30,6 +31,7 @@ pub use dataset::{
     RenderSpec, RenderedDataset, capture_dataset, capture_truth, render_dataset,
 };
 pub use pipeline::GtRenderer;
+pub use preview::{PreviewView, preview};
 pub use sheet::{SheetEntry, contact_sheet, overview_camera};
 
 use glam::{Mat4, Vec3};

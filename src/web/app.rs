@@ -14,6 +14,7 @@ use crate::fit::object::FitConfig;
 use crate::fit::observer::Progress;
 use crate::fit::observer::{Command, Observer, Preview};
 use crate::gpu::now_seconds;
+use crate::pipeline::preview::PREVIEW_FILE;
 use crate::pipeline::{self, FitInput, PipelineError};
 use crate::synth::Category;
 
@@ -296,7 +297,7 @@ pub async fn fit(
 pub struct FitResult(pub(super) Rc<FitFolder>);
 
 /// What the page offers for download.
-const DOWNLOADS: [&str; 4] = [GLB_FILE, ZIP_FILE, JOINTS_FILE, REPORT_FILE];
+const DOWNLOADS: [&str; 5] = [GLB_FILE, ZIP_FILE, JOINTS_FILE, REPORT_FILE, PREVIEW_FILE];
 
 #[wasm_bindgen]
 impl FitResult {

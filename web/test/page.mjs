@@ -262,13 +262,18 @@ try {
   await step("downloads", async () => {
     const saved = {};
     for (const [id, name] of [["#download-glb", "twin.glb"], ["#download-zip", "twin.zip"],
-      ["#download-joints", "joints.json"], ["#download-report", "report.json"]]) {
+      ["#download-joints", "joints.json"], ["#download-report", "report.json"],
+      ["#download-preview", "preview.png"]]) {
       const [dl] = await Promise.all([page.waitForEvent("download", { timeout: 30_000 }), page.click(id)]);
       const path = join(work, "download-" + name);
       await dl.saveAs(path);
       saved[name] = path;
       check(dl.suggestedFilename() === name, `${id} downloads ${dl.suggestedFilename()}`);
     }
+    const png = new Uint8Array(await readFile(saved["preview.png"]));
+    const shown = await page.$eval("#preview", (img) => [img.closest("figure").hidden, img.naturalWidth, img.naturalHeight]);
+    check(png[1] === 0x50 && png[2] === 0x4e && png[3] === 0x47 && !shown[0] && shown[1] > shown[2],
+      `preview.png (${png.length} bytes) is shown under the viewer, ${shown[1]}×${shown[2]}`);
     const glb = new Uint8Array(await readFile(saved["twin.glb"]));
     const report = await validator.validateBytes(glb, {
       maxIssues: 1000,
