@@ -79,7 +79,10 @@ pub(super) fn read_view_set(
     // Refused before decoding: a few kilobytes of PNG can claim gigapixels, and one small image
     // named by thousands of frames decodes once per frame.
     let found: Vec<FrameFiles> = spec.frames.iter().map(|fs| find_frame(files, fs)).collect();
-    let size: u64 = found.iter().map(FrameFiles::decoded_size).sum();
+    let size = found
+        .iter()
+        .map(FrameFiles::decoded_size)
+        .fold(0, u64::saturating_add);
     context.decoded_bytes = context.decoded_bytes.saturating_add(size);
     if context.decoded_bytes > context.max_decoded_bytes {
         let mb = |b: u64| b as f64 / 1e6;
@@ -185,16 +188,20 @@ impl FrameFiles<'_> {
                 _ => 0,
             }
         };
-        let rgba = self.rgba.as_ref().map_or(0, |(_, b)| 4 * png_pixels(b));
+        let rgba = self
+            .rgba
+            .as_ref()
+            .map_or(0, |(_, b)| png_pixels(b).saturating_mul(4));
         let siblings = self.siblings.iter().flatten().flatten().map(|(path, b)| {
             // An .npy holds its values uncompressed: it decodes to about its own size.
             if path.ends_with(".npy") {
                 b.len() as u64
             } else {
-                2 * png_pixels(b)
+                png_pixels(b).saturating_mul(2)
             }
         });
-        rgba + siblings.sum::<u64>()
+        // Saturating: two u32 sides can claim 2⁶⁴ pixels, which must not wrap under the budget.
+        siblings.fold(rgba, u64::saturating_add)
     }
 
     /// Decodes every image found.

@@ -304,7 +304,9 @@ fn write_obj(
     // Materials written so far, keyed by their content, so groups sharing a material share its entry.
     let mut written: Vec<(Material, [f32; 4], String)> = Vec::new();
     let mut textures: HashMap<*const RgbaImage, String> = HashMap::new();
-    let mut base = 1usize; // OBJ indices are 1-based and global to the file
+    // OBJ indices are 1-based and global to the file, counted apart for v, vt and vn (a group
+    // without uvs or normals writes none, so one counter would point later groups astray).
+    let (mut v_base, mut vt_base, mut vn_base) = (1usize, 1usize, 1usize);
     for (g, mesh) in meshes.iter().enumerate() {
         let _ = writeln!(obj, "o group_{g}");
         let colors = mesh
@@ -323,8 +325,11 @@ fn write_obj(
                 }
             }
         }
-        for n in &mesh.normals {
-            let _ = writeln!(obj, "vn {} {} {}", n.x, n.y, n.z);
+        let has_normals = mesh.normals.len() == mesh.positions.len();
+        if has_normals {
+            for n in &mesh.normals {
+                let _ = writeln!(obj, "vn {} {} {}", n.x, n.y, n.z);
+            }
         }
         let uvs = mesh
             .uvs
@@ -376,7 +381,6 @@ fn write_obj(
             };
             let _ = writeln!(obj, "usemtl {name}");
         }
-        let has_normals = mesh.normals.len() == mesh.positions.len();
         for t in &mesh.indices {
             if t.iter().any(|&i| i as usize >= mesh.positions.len()) {
                 return Err(DataError::field(
@@ -389,17 +393,19 @@ fn write_obj(
                 ));
             }
             let corner = |i: u32| {
-                let k = base + i as usize;
+                let [v, t, n] = [v_base, vt_base, vn_base].map(|b| b + i as usize);
                 match (uvs.is_some(), has_normals) {
-                    (true, true) => format!("{k}/{k}/{k}"),
-                    (true, false) => format!("{k}/{k}"),
-                    (false, true) => format!("{k}//{k}"),
-                    (false, false) => format!("{k}"),
+                    (true, true) => format!("{v}/{t}/{n}"),
+                    (true, false) => format!("{v}/{t}"),
+                    (false, true) => format!("{v}//{n}"),
+                    (false, false) => format!("{v}"),
                 }
             };
             let _ = writeln!(obj, "f {} {} {}", corner(t[0]), corner(t[1]), corner(t[2]));
         }
-        base += mesh.positions.len();
+        v_base += mesh.positions.len();
+        vt_base += uvs.map_or(0, Vec::len);
+        vn_base += if has_normals { mesh.normals.len() } else { 0 };
     }
     files.insert(format!("{folder}meshes/{stem}.obj"), obj.into_bytes());
     if materials {

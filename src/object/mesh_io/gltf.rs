@@ -30,8 +30,7 @@ pub(super) fn read_gltf(
     textures: &mut Textures,
     warnings: &mut Vec<String>,
 ) -> Result<Vec<RenderMesh>, DataError> {
-    let gltf = gltf::Gltf::from_slice(bytes)
-        .map_err(|e| DataError::file(path, format!("could not read glTF: {e}")))?;
+    let gltf = parse(path, bytes)?;
     let folder = folder_of(path);
     let buffers = load_buffers(path, folder, &gltf, files)?;
     let mut reader = GltfReader {
@@ -61,6 +60,33 @@ pub(super) fn read_gltf(
         }
     }
     Ok(reader.out)
+}
+
+/// Parses and validates a GLB or `.gltf`. The gltf crate's validation indexes a primitive's
+/// accessors before checking them (a panic on an out-of-range index), so they are checked first.
+fn parse(path: &str, bytes: &[u8]) -> Result<gltf::Gltf, DataError> {
+    let cannot = |e: gltf::Error| DataError::file(path, format!("could not read glTF: {e}"));
+    let unchecked = gltf::Gltf::from_slice_without_validation(bytes).map_err(cannot)?;
+    let json = unchecked.document.into_json();
+    let accessors = json.accessors.len();
+    for (m, mesh) in json.meshes.iter().enumerate() {
+        for (p, prim) in mesh.primitives.iter().enumerate() {
+            let used = prim.attributes.values().chain(prim.indices.as_ref());
+            if let Some(bad) = used.map(|a| a.value()).find(|&a| a >= accessors) {
+                return Err(DataError::file(
+                    path,
+                    format!(
+                        "could not read glTF: mesh {m} primitive {p} uses accessor {bad}, but the file has {accessors}"
+                    ),
+                ));
+            }
+        }
+    }
+    let document = gltf::Document::from_json(json).map_err(cannot)?;
+    Ok(gltf::Gltf {
+        document,
+        blob: unchecked.blob,
+    })
 }
 
 /// Bytes of every buffer (GLB chunk, external file or data URI), each checked against its declared

@@ -1,6 +1,7 @@
 //! Wavefront OBJ reader: geometry through `tobj`, materials from the `.mtl` library, PNG `map_Kd` textures.
 //! OBJ's `v` texture coordinate is flipped so that `v = 0` is the top row, as in glTF.
 
+use std::borrow::Cow;
 use std::io::{BufReader, Cursor};
 
 use glam::{Vec2, Vec3};
@@ -45,7 +46,8 @@ pub(super) fn read_obj(
             return Err(tobj::LoadError::OpenFileFailed);
         };
         *mtl_folder.borrow_mut() = folder_of(&key).to_string();
-        tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(data))).inspect_err(|e| {
+        let data = full_colours(data);
+        tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(&data[..]))).inspect_err(|e| {
             notes.borrow_mut().push(format!(
                 "{key}: could not read material library ({e}); using plain colours"
             ));
@@ -125,4 +127,53 @@ pub(super) fn read_obj(
         });
     }
     Ok(out)
+}
+
+/// The MTL text with every `Ka`/`Kd`/`Ks`/`Ke` colour given as three numbers. The format lets
+/// `g` and `b` be left out (they then equal `r`); tobj panics on such a line instead, and on one
+/// with no number at all, which is dropped.
+fn full_colours(mtl: &[u8]) -> Cow<'_, [u8]> {
+    let short = |line: &str| -> Option<String> {
+        let mut words = line.split_whitespace();
+        let key = words.next()?;
+        let rgb: Vec<&str> = words.collect();
+        let numbers = rgb.iter().all(|w| w.parse::<f32>().is_ok());
+        if !matches!(key, "Ka" | "Kd" | "Ks" | "Ke") || !numbers || rgb.len() >= 3 {
+            return None;
+        }
+        // No number at all: the colour is not given (the line is dropped).
+        Some(rgb.first().map_or(String::new(), |r| {
+            format!("{key} {r} {} {r}", rgb.get(1).unwrap_or(r))
+        }))
+    };
+    // Line by line on bytes: a line that is not UTF-8 (tobj's error to report) must not stop the
+    // lines before it from being completed.
+    let fixed = |line: &[u8]| std::str::from_utf8(line).ok().and_then(short);
+    if !mtl.split(|&b| b == b'\n').any(|l| fixed(l).is_some()) {
+        return Cow::Borrowed(mtl);
+    }
+    let lines: Vec<Vec<u8>> = mtl
+        .split(|&b| b == b'\n')
+        .map(|l| fixed(l).map_or_else(|| l.to_vec(), String::into_bytes))
+        .collect();
+    Cow::Owned(lines.join(&b'\n'))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn short_mtl_colours_are_completed() {
+        let mtl = b"newmtl a\nKd 0.7\nKa 0.1 0.2\nKs 1 1 1\nKe spectral x.rfl\nKe\n";
+        let full = full_colours(mtl);
+        assert_eq!(
+            std::str::from_utf8(&full).unwrap(),
+            "newmtl a\nKd 0.7 0.7 0.7\nKa 0.1 0.2 0.1\nKs 1 1 1\nKe spectral x.rfl\n\n"
+        );
+        // tobj reads the completed colours (it refuses the spectral form, as before: an error).
+        let readable = full_colours(b"newmtl a\nKd 0.7\n");
+        let materials = tobj::load_mtl_buf(&mut BufReader::new(Cursor::new(&readable[..])));
+        assert_eq!(materials.unwrap().0[0].diffuse, Some([0.7; 3]));
+    }
 }
