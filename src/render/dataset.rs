@@ -92,7 +92,9 @@ pub enum ObjectProblem {
         parent: usize,
     },
     /// A movable part with no triangle of positive area.
-    #[error("part {part} (links {links}) has no visible surface: give its links visual geometry")]
+    #[error(
+        "part {part} (links {links}) has no triangle of positive area: give its links visual geometry that is not empty or flat"
+    )]
     NoSurface {
         /// The part.
         part: usize,

@@ -97,6 +97,17 @@ impl Reader<'_, '_> {
         let scale = self
             .numbers::<3>(node, path, "scale", true)?
             .map_or(Vec3::ONE, Vec3::from_array);
+        if scale.to_array().contains(&0.0) {
+            return Err(self.err(
+                node,
+                path,
+                Some("scale"),
+                format!(
+                    "a scale of 0 flattens the mesh to nothing (found {} {} {}); expected non-zero factors",
+                    scale.x, scale.y, scale.z
+                ),
+            ));
+        }
         let key = self.resolve(filename, node, path)?;
         if MeshFormat::from_path(&key).is_none() {
             let ext = key.rsplit_once('.').map_or("(none)", |(_, e)| e);
