@@ -101,6 +101,10 @@ try {
     const state = await body();
     check(state.state === "done", `page started (state=${state.state}${state.error ? ", error: " + state.error : ""})`);
     check(Boolean(state.adapter), `adapter reported: ${state.adapter}`);
+    if (state.software === "true") {
+      const presets = [await page.inputValue("#demo-preset"), await page.inputValue("#fit-preset")];
+      check(presets.every((p) => p === "tiny"), `a software adapter starts at the tiny preset (${presets.join(", ")})`);
+    }
     await page.click("#selftest-run");
     await page.waitForFunction(() => ["pass", "fail"].includes(document.body.dataset.selftest) ||
       document.body.dataset.state === "panic", null,
