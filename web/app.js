@@ -69,8 +69,12 @@ async function gpuSection() {
   try {
     adapter = JSON.parse(await wasm.adapter_report());
   } catch (e) {
-    noGpu(`WebGPU is there but no GPU adapter could be opened: ${errorText(e)}\n` +
-      "Check that hardware acceleration is on in the browser's settings.");
+    // The error lists the backends wgpu tried ("noop not requested, vulkan not requested, …"):
+    // for the console, not for the visitor.
+    console.error("no WebGPU adapter:", errorText(e));
+    noGpu("This browser offers WebGPU but gave the page no GPU adapter: it may block WebGPU for this GPU or " +
+      "driver, or hardware acceleration may be off.\nTurn hardware acceleration on in the browser's settings, " +
+      "or try another browser.");
     document.body.dataset.error = errorText(e);
     return false;
   }
