@@ -187,6 +187,12 @@ export function setupInput(DatasetClass, { onDataset, onProblems }) {
     zone.addEventListener(type, (e) => { e.preventDefault(); zone.classList.add("over"); });
   }
   zone.addEventListener("dragleave", () => zone.classList.remove("over"));
+  // From the keyboard the zone is a button for the folder picker (Tab on reaches the .zip one).
+  zone.addEventListener("keydown", (e) => {
+    if (e.target !== zone || (e.key !== "Enter" && e.key !== " ")) return;
+    e.preventDefault();
+    $("folder").click();
+  });
   zone.addEventListener("drop", (e) => {
     e.preventDefault();
     zone.classList.remove("over");
