@@ -274,8 +274,6 @@ pub fn read_zip_within(
 mod tests {
     use super::*;
     use crate::data::{Dataset, fixture};
-    use std::io::Write;
-    use zip::write::SimpleFileOptions;
 
     fn dataset_files() -> FileSet {
         fixture::small_dataset(fixture::FixtureParams::default())
@@ -284,25 +282,10 @@ mod tests {
     }
 
     /// A zip of `files` under `my-scan/`, plus `copies` entries `my-scan/{stem}{i}.bin` of
-    /// `size` zero bytes each (deflated once, then copied as they are).
+    /// `size` zero bytes each.
     fn zip_with(files: &FileSet, stem: &str, copies: usize, size: usize) -> Vec<u8> {
-        let options =
-            SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-        let mut one = zip::ZipWriter::new(Cursor::new(Vec::new()));
-        one.start_file("zeros", options).unwrap();
-        one.write_all(&vec![0; size]).unwrap();
-        let mut one = zip::ZipArchive::new(one.finish().unwrap()).unwrap();
-        let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
-        for (path, bytes) in files {
-            zip.start_file(format!("my-scan/{path}"), options).unwrap();
-            zip.write_all(bytes).unwrap();
-        }
-        for i in 0..copies {
-            let entry = one.by_index(0).unwrap();
-            zip.raw_copy_file_rename(entry, format!("my-scan/{stem}{i}.bin"))
-                .unwrap();
-        }
-        zip.finish().unwrap().into_inner()
+        crate::fixtures::hostile::inputs::zip_with_zeros(files, "my-scan", stem, copies, size)
+            .unwrap()
     }
 
     fn total(files: &FileSet) -> u64 {

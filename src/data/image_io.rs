@@ -188,6 +188,19 @@ fn format_error(file: &str, color: ColorType, expected_bits: u16, expected: &str
     )
 }
 
+/// The pixel count a PNG's header claims (width × height, read before any decoding: a few
+/// kilobytes of PNG can claim gigapixels); 0 when `bytes` has no PNG header, whose decoder then
+/// names the problem.
+pub fn png_claimed_pixels(bytes: &[u8]) -> u64 {
+    match bytes.get(12..24) {
+        Some(h) if &h[..4] == b"IHDR" => {
+            let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
+            be(&h[4..8]) * be(&h[8..12])
+        }
+        _ => 0,
+    }
+}
+
 /// Reads an 8-bit RGBA (or RGB, taken as opaque) PNG.
 pub(crate) fn decode_rgba(file: &str, bytes: &[u8]) -> Result<RgbaImage, DataError> {
     let img = decode(file, bytes)?;

@@ -49,7 +49,7 @@ pub use frame::Frame;
 #[cfg(not(target_arch = "wasm32"))]
 pub use fs::{ReadDatasetError, read_dataset, read_dataset_files, read_dir, write_dir};
 pub use gt::{GtJoint, GtMeshes, JointKind};
-pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png};
+pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png, png_claimed_pixels};
 #[cfg(not(target_arch = "wasm32"))]
 pub use lazy_folder::LazyFolder;
 pub use npy::encode_npy;

@@ -179,15 +179,7 @@ impl FrameFiles<'_> {
     /// Bytes the images decode to, from their headers (0 for an image whose header does not
     /// read: its decoder names the problem).
     fn decoded_size(&self) -> u64 {
-        let png_pixels = |bytes: &[u8]| -> u64 {
-            match bytes.get(12..24) {
-                Some(h) if &h[..4] == b"IHDR" => {
-                    let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
-                    be(&h[4..8]) * be(&h[8..12])
-                }
-                _ => 0,
-            }
-        };
+        let png_pixels = image_io::png_claimed_pixels;
         let rgba = self
             .rgba
             .as_ref()

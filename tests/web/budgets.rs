@@ -2,9 +2,10 @@
 //! error within the budget and seconds, and of a dropped folder only the dataset's own files are
 //! asked for (a 4 GB recording beside them is not).
 
-use std::io::{Cursor, Write};
+use std::io::Cursor;
 
 use artmesh::data::{self, FileSet, fixture};
+use artmesh::fixtures::hostile;
 use artmesh::web::app::WebDataset;
 use js_sys::Uint8Array;
 use wasm_bindgen::JsCast;
@@ -12,24 +13,9 @@ use wasm_bindgen_test::*;
 use zip::write::SimpleFileOptions;
 
 /// A zip holding `files` under `scan/` and `copies` entries `scan/gt/zeros{i}.bin` of `size`
-/// zero bytes each (deflated once, then copied as they are).
+/// zero bytes each.
 fn zip_with_zeros(files: &FileSet, copies: usize, size: usize) -> Vec<u8> {
-    let options = SimpleFileOptions::default().compression_method(zip::CompressionMethod::Deflated);
-    let mut one = zip::ZipWriter::new(Cursor::new(Vec::new()));
-    one.start_file("zeros", options).unwrap();
-    one.write_all(&vec![0; size]).unwrap();
-    let mut one = zip::ZipArchive::new(one.finish().unwrap()).unwrap();
-    let mut zip = zip::ZipWriter::new(Cursor::new(Vec::new()));
-    for (path, bytes) in files {
-        zip.start_file(format!("scan/{path}"), options).unwrap();
-        zip.write_all(bytes).unwrap();
-    }
-    for i in 0..copies {
-        let entry = one.by_index(0).unwrap();
-        zip.raw_copy_file_rename(entry, format!("scan/gt/zeros{i}.bin"))
-            .unwrap();
-    }
-    zip.finish().unwrap().into_inner()
+    hostile::inputs::zip_with_zeros(files, "scan", "gt/zeros", copies, size).unwrap()
 }
 
 fn seconds_since(t0: f64) -> f64 {

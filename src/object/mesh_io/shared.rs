@@ -7,7 +7,7 @@ use std::sync::Arc;
 
 use glam::Vec3;
 
-use crate::data::{DataError, FileSource, RgbaImage};
+use crate::data::{DataError, FileSource, RgbaImage, png_claimed_pixels};
 
 /// Pixels all the textures of one import may decode to (1 GiB of RGBA): past it a texture is
 /// skipped with a warning, as an unreadable one is.
@@ -44,14 +44,7 @@ impl Textures {
         bytes: &[u8],
         warnings: &mut Vec<String>,
     ) -> Option<Arc<RgbaImage>> {
-        // The header's size, before decoding: a few kilobytes of PNG can claim gigapixels.
-        let claimed = match bytes.get(12..24) {
-            Some(h) if &h[..4] == b"IHDR" => {
-                let be = |b: &[u8]| u64::from(u32::from_be_bytes([b[0], b[1], b[2], b[3]]));
-                be(&h[4..8]) * be(&h[8..12])
-            }
-            _ => 0,
-        };
+        let claimed = png_claimed_pixels(bytes);
         if self.pixels.saturating_add(claimed) > MAX_TEXTURE_PIXELS {
             warnings.push(format!(
                 "{key}: texture of {claimed} pixels would take this object's textures past {} MB decoded; using the base colour",
