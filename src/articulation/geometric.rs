@@ -35,6 +35,7 @@ use super::init::{JointCandidates, initial_candidates};
 use super::motion::PartMotion;
 use super::observed::PartCloud;
 use crate::data::JointKind;
+use crate::data::parallel;
 
 /// The prismatic model wins while its residual is at most this many times the revolute one.
 pub(crate) const PRISMATIC_SLACK: f64 = 1.2;
@@ -123,21 +124,41 @@ fn revolute_starts(start: &PartCloud) -> Vec<PartMotion> {
 /// Distinct starts refined fully after the coarse search.
 const FINALISTS: usize = 12;
 
+/// Steps of each start in the coarse search, and of each finalist on the whole clouds.
+const COARSE_STEPS: usize = 6;
+const FULL_STEPS: usize = 40;
+
+/// `starts` refined briefly ([`COARSE_STEPS`]) on clouds thinned to about [`SEARCH_POINTS`],
+/// best (smallest coarse residual) first.
+fn coarse_search(pair: &CloudPair, model: Model, starts: &[PartMotion]) -> Vec<(f64, PartMotion)> {
+    let step = pair.start.points.len().max(pair.end.points.len()) / SEARCH_POINTS + 1;
+    let (a, b) = (thinned(pair.start, step), thinned(pair.end, step));
+    let coarse = CloudPair::new(&a, &b);
+    // The starts are independent: refined on every core, results in start order.
+    let mut tried = parallel::map(starts, |&m| {
+        let m = refine(&coarse, model, m, COARSE_STEPS);
+        (coarse.residual(&m), m)
+    });
+    tried.sort_by(|x, y| x.0.total_cmp(&y.0));
+    tried
+}
+
+/// `motions` refined fully ([`FULL_STEPS`]) on the whole clouds, with their residuals.
+fn full_fits(pair: &CloudPair, model: Model, motions: &[PartMotion]) -> Vec<(f64, PartMotion)> {
+    parallel::map(motions, |&m| {
+        let m = refine(pair, model, m, FULL_STEPS);
+        (pair.residual(&m), m)
+    })
+}
+
 /// The best revolute motion: the registration seed and every turn of [`revolute_starts`]
 /// refined briefly on thinned clouds; the best few distinct ones (within twice the best
 /// residual) refined fully, then [`most_plausible`] of those.
 fn best_revolute(pair: &CloudPair, seed: PartMotion, anchor: Option<&Anchor>) -> PartMotion {
-    let step = pair.start.points.len().max(pair.end.points.len()) / SEARCH_POINTS + 1;
-    let (a, b) = (thinned(pair.start, step), thinned(pair.end, step));
-    let coarse = CloudPair::new(&a, &b);
-    let mut tried: Vec<(f64, PartMotion)> = std::iter::once(seed)
+    let starts: Vec<PartMotion> = std::iter::once(seed)
         .chain(revolute_starts(pair.start))
-        .map(|m| {
-            let m = refine(&coarse, Model::Revolute, m, 6);
-            (coarse.residual(&m), m)
-        })
         .collect();
-    tried.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let tried = coarse_search(pair, Model::Revolute, &starts);
     let best = tried.first().map_or(f64::INFINITY, |t| t.0);
     let mut finalists: Vec<PartMotion> = Vec::new();
     for (r, m) in &tried {
@@ -148,19 +169,17 @@ fn best_revolute(pair: &CloudPair, seed: PartMotion, anchor: Option<&Anchor>) ->
             finalists.push(*m);
         }
     }
-    let fits: Vec<(f64, PartMotion)> = finalists
-        .into_iter()
-        .map(|m| {
-            let m = refine(pair, Model::Revolute, m, 40);
-            (pair.residual(&m), m)
-        })
-        .collect();
+    let fits = full_fits(pair, Model::Revolute, &finalists);
     most_plausible(&fits, pair, anchor).unwrap_or(seed)
 }
 
+/// Slides refined fully after the coarse search.
+const SLIDE_FINALISTS: usize = 2;
+
 /// The best translation: from the registration's slide, from where the best revolute motion
 /// takes the part's centroid (a drawer seen deeper when open pulls the centroids apart), and
-/// from 0.7 to 1.3 times the slide.
+/// from 0.7 to 1.3 times the slide; searched coarsely, the best [`SLIDE_FINALISTS`] refined
+/// fully.
 fn best_prismatic(pair: &CloudPair, seed: PartMotion, revolute: &PartMotion) -> PartMotion {
     let n = pair.start.points.len().max(1) as f64;
     let centroid = pair
@@ -173,18 +192,22 @@ fn best_prismatic(pair: &CloudPair, seed: PartMotion, revolute: &PartMotion) -> 
     // A slide seen partly (a drawer's sides hidden when closed) can stop short of or past the
     // travel: starts along the seed's direction at a range of fractions of it, too.
     let along = [0.7, 0.85, 1.15, 1.3].map(|f| PartMotion::prismatic(seed.translation * f));
-    [
+    let starts: Vec<PartMotion> = [
         seed,
         PartMotion::prismatic(revolute.forward(centroid) - centroid),
     ]
     .into_iter()
     .chain(along)
-    .map(|m| {
-        let m = refine(pair, Model::Prismatic, m, 40);
-        (pair.residual(&m), m)
-    })
-    .min_by(|x, y| x.0.total_cmp(&y.0))
-    .map_or(seed, |t| t.1)
+    .collect();
+    let finalists: Vec<PartMotion> = coarse_search(pair, Model::Prismatic, &starts)
+        .into_iter()
+        .take(SLIDE_FINALISTS)
+        .map(|t| t.1)
+        .collect();
+    full_fits(pair, Model::Prismatic, &finalists)
+        .into_iter()
+        .min_by(|x, y| x.0.total_cmp(&y.0))
+        .map_or(seed, |t| t.1)
 }
 
 /// The geometric fit of a part measured as `start` and `end`, `anchor` holding the rest of the

@@ -12,6 +12,7 @@ use glam::{DMat3, DQuat, DVec3, Vec3};
 use serde::Serialize;
 
 use super::motion::{PartMotion, closest_on_line, rotation_axis_angle};
+use crate::data::parallel;
 use crate::mesh::spatial::KdTree;
 
 /// Eigen-decomposition of a symmetric n × n matrix by cyclic Jacobi rotations: eigenvalues in
@@ -233,17 +234,15 @@ pub(crate) fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCa
         .map(|s| DQuat::from_mat3(&(f2.axes * DMat3::from_diagonal(*s) * f1.axes.transpose())))
         .collect();
     seeds.push(DQuat::IDENTITY);
-    let registrations: Vec<Registration> = seeds
-        .into_iter()
-        .map(|rotation| {
-            let reg = Registration {
-                rotation,
-                translation: f2.centroid - rotation * f1.centroid,
-                residual: 0.0,
-            };
-            icp(start, &tree, reg, true)
-        })
-        .collect();
+    // Independent registrations: on every core, results in seed order.
+    let registrations: Vec<Registration> = parallel::map(&seeds, |&rotation| {
+        let reg = Registration {
+            rotation,
+            translation: f2.centroid - rotation * f1.centroid,
+            residual: 0.0,
+        };
+        icp(start, &tree, reg, true)
+    });
     // Symmetric parts (a door slab) register equally well turned by 180°: among the registrations
     // that fit about as well as the best, take the smallest rotation — joints rarely turn further.
     let best = registrations

@@ -12,6 +12,7 @@ use glam::{DVec3, Vec2, Vec3};
 use serde::Serialize;
 
 use crate::data::Frame;
+use crate::data::parallel;
 
 /// How the clouds are sampled.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -100,74 +101,85 @@ fn samples(
         .map(|f| f.rgba.width as usize * f.rgba.height as usize)
         .sum();
     let stride = ((pixels as f64 / max_samples.max(1) as f64).sqrt().ceil() as usize).max(1);
+    // Frames are independent: sampled on every core, concatenated in frame order.
+    let per_frame = parallel::map(&usable, |frame| frame_samples(frame, num_parts, stride));
+    let mut out = Vec::with_capacity(per_frame.iter().map(|f| f.0.len()).sum());
+    let mut labelled = vec![0; num_parts];
+    for (samples, counts) in per_frame {
+        out.extend(samples);
+        labelled.iter_mut().zip(counts).for_each(|(n, c)| *n += c);
+    }
+    (out, labelled, usable.len(), stride)
+}
+
+/// One frame's samples at pixel stride `stride`, and its pixel count per part label.
+fn frame_samples(frame: &Frame, num_parts: usize, stride: usize) -> (Vec<Sample>, Vec<usize>) {
     let mut out = Vec::new();
     let mut labelled = vec![0; num_parts];
-    for frame in &usable {
-        let (Some(depth), Some(parts)) = (&frame.depth, &frame.parts) else {
-            continue;
-        };
-        for &id in &parts.ids {
-            if let Some(n) = usize::try_from(id).ok().and_then(|i| labelled.get_mut(i)) {
-                *n += 1;
-            }
+    let (Some(depth), Some(parts)) = (&frame.depth, &frame.parts) else {
+        return (out, labelled);
+    };
+    for &id in &parts.ids {
+        if let Some(n) = usize::try_from(id).ok().and_then(|i| labelled.get_mut(i)) {
+            *n += 1;
         }
-        let (w, h) = (frame.rgba.width as usize, frame.rgba.height as usize);
-        let eye = frame.camera.position();
-        let point = |x: usize, y: usize| -> Option<Vec3> {
-            let d = depth.millimetres[y * w + x];
-            (d > 0).then(|| {
-                frame.camera.unproject(
-                    Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
-                    f32::from(d) / 1000.0,
-                )
-            })
-        };
-        const R: usize = NORMAL_REACH;
-        for y in (R..h.saturating_sub(R)).step_by(stride) {
-            for x in (R..w.saturating_sub(R)).step_by(stride) {
-                let i = y * w + x;
-                let id = parts.ids[i];
-                if id < 0 || id as usize >= num_parts {
-                    continue;
-                }
-                // The neighbours out to the normal's reach on the same part and surface: no
-                // silhouette, no jump.
-                let same = (1..=R)
-                    .flat_map(|k| [i - k, i + k, i - k * w, i + k * w])
-                    .all(|j| parts.ids[j] == id);
-                let (Some(c), Some(l), Some(r), Some(u), Some(d)) = (
-                    point(x, y),
-                    point(x - R, y),
-                    point(x + R, y),
-                    point(x, y - R),
-                    point(x, y + R),
-                ) else {
-                    continue;
-                };
-                let reach = (c - eye).length();
-                let smooth = [l, r, u, d]
-                    .iter()
-                    .all(|q| (*q - c).length() < 0.02 * R as f32 * reach);
-                if !same || !smooth {
-                    continue;
-                }
-                let mut normal = (r - l).cross(u - d).normalize_or_zero();
-                if normal.dot(eye - c) < 0.0 {
-                    normal = -normal;
-                }
-                if normal != Vec3::ZERO {
-                    let rgb = &frame.rgba.pixels[4 * i..4 * i + 3];
-                    out.push(Sample {
-                        part: id as usize,
-                        point: c,
-                        normal,
-                        color: Vec3::new(rgb[0].into(), rgb[1].into(), rgb[2].into()) / 255.0,
-                    });
-                }
+    }
+    let (w, h) = (frame.rgba.width as usize, frame.rgba.height as usize);
+    let eye = frame.camera.position();
+    let point = |x: usize, y: usize| -> Option<Vec3> {
+        let d = depth.millimetres[y * w + x];
+        (d > 0).then(|| {
+            frame.camera.unproject(
+                Vec2::new(x as f32 + 0.5, y as f32 + 0.5),
+                f32::from(d) / 1000.0,
+            )
+        })
+    };
+    const R: usize = NORMAL_REACH;
+    for y in (R..h.saturating_sub(R)).step_by(stride) {
+        for x in (R..w.saturating_sub(R)).step_by(stride) {
+            let i = y * w + x;
+            let id = parts.ids[i];
+            if id < 0 || id as usize >= num_parts {
+                continue;
+            }
+            // The neighbours out to the normal's reach on the same part and surface: no
+            // silhouette, no jump.
+            let same = (1..=R)
+                .flat_map(|k| [i - k, i + k, i - k * w, i + k * w])
+                .all(|j| parts.ids[j] == id);
+            let (Some(c), Some(l), Some(r), Some(u), Some(d)) = (
+                point(x, y),
+                point(x - R, y),
+                point(x + R, y),
+                point(x, y - R),
+                point(x, y + R),
+            ) else {
+                continue;
+            };
+            let reach = (c - eye).length();
+            let smooth = [l, r, u, d]
+                .iter()
+                .all(|q| (*q - c).length() < 0.02 * R as f32 * reach);
+            if !same || !smooth {
+                continue;
+            }
+            let mut normal = (r - l).cross(u - d).normalize_or_zero();
+            if normal.dot(eye - c) < 0.0 {
+                normal = -normal;
+            }
+            if normal != Vec3::ZERO {
+                let rgb = &frame.rgba.pixels[4 * i..4 * i + 3];
+                out.push(Sample {
+                    part: id as usize,
+                    point: c,
+                    normal,
+                    color: Vec3::new(rgb[0].into(), rgb[1].into(), rgb[2].into()) / 255.0,
+                });
             }
         }
     }
-    (out, labelled, usable.len(), stride)
+    (out, labelled)
 }
 
 /// A robust size of a point set: twice the RMS distance from its centroid.
@@ -247,26 +259,29 @@ pub(crate) fn observe_states(
     let edges: Vec<f32> = (0..num_parts)
         .map(|part| voxel_edge([&sampled[0].0, &sampled[1].0], part, options))
         .collect();
+    // Each (state, part) cloud is independent: voxelised on every core.
+    let jobs: Vec<(usize, usize)> = (0..2)
+        .flat_map(|s| (0..num_parts).map(move |part| (s, part)))
+        .collect();
+    let mut clouds = parallel::map(&jobs, |&(s, part)| {
+        let mine: Vec<&Sample> = sampled[s].0.iter().filter(|x| x.part == part).collect();
+        let mut edge = edges[part];
+        loop {
+            let cloud = voxelise(&mine, edge);
+            if cloud.points.len() <= options.max_points {
+                return PartCloud {
+                    labelled: sampled[s].1[part],
+                    ..cloud
+                };
+            }
+            edge *= 1.25;
+        }
+    })
+    .into_iter();
     std::array::from_fn(|s| {
-        let (all, labelled, views_with_depth, stride) = &sampled[s];
-        let parts = (0..num_parts)
-            .map(|part| {
-                let mine: Vec<&Sample> = all.iter().filter(|x| x.part == part).collect();
-                let mut edge = edges[part];
-                loop {
-                    let cloud = voxelise(&mine, edge);
-                    if cloud.points.len() <= options.max_points {
-                        return PartCloud {
-                            labelled: labelled[part],
-                            ..cloud
-                        };
-                    }
-                    edge *= 1.25;
-                }
-            })
-            .collect();
+        let (_, _, views_with_depth, stride) = &sampled[s];
         ObservedState {
-            parts,
+            parts: clouds.by_ref().take(num_parts).collect(),
             views_with_depth: *views_with_depth,
             views: frames[s].len(),
             stride: *stride,

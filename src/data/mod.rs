@@ -31,7 +31,7 @@ mod json;
 #[cfg(not(target_arch = "wasm32"))]
 mod lazy_folder;
 mod npy;
-mod parallel;
+pub(crate) mod parallel;
 mod paths;
 mod ply;
 mod summary;

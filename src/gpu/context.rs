@@ -81,6 +81,8 @@ pub struct GpuContext {
     pub limits: wgpu::Limits,
     dispatch_dim_limit: u32,
     errors: Arc<Mutex<Vec<String>>>,
+    /// The adapter the device came from (for [`GpuContext::another_device`]).
+    source: wgpu::Adapter,
 }
 
 #[cfg(not(target_arch = "wasm32"))]
@@ -113,6 +115,17 @@ impl GpuContext {
                 detail: e.to_string(),
                 hint: NO_ADAPTER_HINT,
             })?;
+        Self::on_adapter(adapter).await
+    }
+
+    /// A second device on this context's adapter, with its own queue: work submitted to it
+    /// runs beside this one's without sharing its locks (natively, a thread per device).
+    pub async fn another_device(&self) -> GpuResult<Self> {
+        Self::on_adapter(self.source.clone()).await
+    }
+
+    /// A device with the adapter's own limits, and its error log.
+    async fn on_adapter(adapter: wgpu::Adapter) -> GpuResult<Self> {
         let info = adapter.get_info();
         let limits = adapter.limits();
         let (device, queue) = adapter
@@ -144,7 +157,7 @@ impl GpuContext {
             ("", _) => "unnamed adapter".to_string(),
             (name, _) => name.to_string(),
         };
-        let adapter = AdapterReport {
+        let report = AdapterReport {
             name,
             backend: format!("{:?}", info.backend),
             device_type: format!("{:?}", info.device_type),
@@ -160,9 +173,10 @@ impl GpuContext {
             device,
             queue,
             dispatch_dim_limit: limits.max_compute_workgroups_per_dimension.max(1),
-            adapter,
+            adapter: report,
             limits,
             errors,
+            source: adapter,
         })
     }
 

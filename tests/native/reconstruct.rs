@@ -1,10 +1,16 @@
 //! The reconstruction phase on lavapipe: a `tiny` reconstruction of a 2-part object gives one
 //! mesh per part per state with no cross-part face, near its ground truth; the global-remeshing
-//! ablation builds faces across parts and the report counts them.
+//! ablation builds faces across parts and the report counts them; natively both states run at
+//! once and come out as each does alone, heard in the order they would be in turn.
 
+use artmesh::data::State;
 use artmesh::eval::mesh_quality::reconstruction_failures;
-use artmesh::fit::reconstruct::RemeshMode;
-use artmesh::fixtures::object::tiny_reconstruction;
+use artmesh::fit::observer::{Phase, Progress, Unobserved};
+use artmesh::fit::preset::Preset;
+use artmesh::fit::reconstruct::{
+    ReconstructionConfig, RemeshMode, reconstruct, reconstruct_state, training_views,
+};
+use artmesh::fixtures::object::{tiny_laptop, tiny_reconstruction};
 use artmesh::mesh::topology::cross_part_faces;
 
 use crate::common::context;
@@ -57,4 +63,38 @@ fn global_remeshing_builds_faces_across_parts_and_the_report_counts_them() {
     // The laptop's lid meets its base at the hinge: one Delaunay over both joins them.
     assert!(crossing.iter().any(|&c| c > 0), "{crossing:?}");
     assert!(!reconstruction_failures(&report, 1e9, 0.0).is_empty());
+}
+
+#[test]
+fn both_states_at_once_come_out_as_each_alone_and_are_heard_in_turn() {
+    let ctx = context();
+    let dataset = pollster::block_on(tiny_laptop(&ctx)).unwrap();
+    let config = ReconstructionConfig::preset(Preset::Tiny);
+    let mut events: Vec<Progress> = Vec::new();
+    let mut listen = |e: &Progress| events.push(*e);
+    let both = pollster::block_on(reconstruct(&ctx, &dataset, &config, &mut listen)).unwrap();
+    for (state, together) in State::ALL.into_iter().zip(&both.states) {
+        let frames = training_views(&dataset, state, &config).unwrap();
+        let k = dataset.num_parts;
+        let alone = pollster::block_on(reconstruct_state(
+            &ctx,
+            state,
+            &frames,
+            k,
+            &config,
+            &mut Unobserved,
+        ))
+        .unwrap();
+        assert!(together.field == alone.field, "{state:?} differs");
+        assert_eq!(together.psnr_recovered, alone.psnr_recovered);
+    }
+    // Every start-state event first, each state closing with its Done.
+    let states: Vec<State> = events.iter().map(|e| e.state).collect();
+    let switch = states.iter().position(|&s| s == State::End).unwrap();
+    assert!(
+        states[switch..].iter().all(|&s| s == State::End),
+        "{states:?}"
+    );
+    assert_eq!(events[switch - 1].phase, Phase::Done);
+    assert_eq!(events.last().unwrap().phase, Phase::Done);
 }

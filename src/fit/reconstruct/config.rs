@@ -110,16 +110,18 @@ impl ReconstructionConfig {
                     max_triangles: 8_000,
                     ..InitOptions::default()
                 },
+                // The schedule scales with the budget: the SH degree rises over the first
+                // 90 % of the steps, and the densification window holds about four rounds.
                 fit: PhotometricConfig {
                     iterations: b.reconstruction_iterations,
                     report_every: 20,
-                    sh_degree_every: 120,
+                    sh_degree_every: (b.reconstruction_iterations * 3 / 10).max(1),
                     ..base
                 },
                 densify: DensifyConfig {
                     from: 0.1,
                     until: 0.5,
-                    every: 40,
+                    every: (b.reconstruction_iterations / 10).max(24),
                     max_faces: b.max_faces,
                     ..DensifyConfig::default()
                 },

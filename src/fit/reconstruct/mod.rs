@@ -16,9 +16,11 @@
 //!
 //! Files: `config` (settings per preset), `results` (what a state's reconstruction
 //! produces), `densify` (densification and pruning), `remesh` (hardening and remeshing),
-//! `state` (the stages of one state in order); this file picks the training views and runs
-//! both states.
+//! `state` (the stages of one state in order), `both` (natively, the two states at once); this
+//! file picks the training views and runs both states.
 
+#[cfg(not(target_arch = "wasm32"))]
+mod both;
 mod config;
 mod densify;
 mod remesh;
@@ -37,10 +39,10 @@ use crate::gpu::{GpuContext, GpuError, GpuResult};
 /// A state of the dataset without training views, so there is nothing to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
 #[error("the dataset has no {} training views", .0.name())]
-pub(crate) struct NoTrainingViews(pub State);
+pub struct NoTrainingViews(pub State);
 
 /// The training views of `state` under `config`: evenly spaced, downsampled.
-pub(crate) fn training_views(
+pub fn training_views(
     dataset: &Dataset,
     state: State,
     config: &ReconstructionConfig,
@@ -67,21 +69,28 @@ pub(crate) fn training_views(
         .collect())
 }
 
-/// Reconstructs both states of `dataset`.
+/// Reconstructs both states of `dataset`: natively at once ([`both`]), in the browser in turn.
 pub async fn reconstruct(
     ctx: &GpuContext,
     dataset: &Dataset,
     config: &ReconstructionConfig,
     observer: &mut dyn Observer,
 ) -> GpuResult<Reconstruction> {
-    let mut states = Vec::new();
-    for state in [State::Start, State::End] {
-        let frames = training_views(dataset, state, config)
-            .map_err(|e| GpuError::InvalidInput(e.to_string()))?;
-        states.push(
-            reconstruct_state(ctx, state, &frames, dataset.num_parts, config, observer).await?,
-        );
-    }
+    let views = |state| {
+        training_views(dataset, state, config).map_err(|e| GpuError::InvalidInput(e.to_string()))
+    };
+    let frames = [views(State::Start)?, views(State::End)?];
+    let k = dataset.num_parts;
+    #[cfg(not(target_arch = "wasm32"))]
+    let states = both::reconstruct_both(ctx, [&frames[0], &frames[1]], k, config, observer)?.into();
+    #[cfg(target_arch = "wasm32")]
+    let states = {
+        let mut states = Vec::new();
+        for (state, frames) in State::ALL.into_iter().zip(&frames) {
+            states.push(reconstruct_state(ctx, state, frames, k, config, observer).await?);
+        }
+        states
+    };
     Ok(Reconstruction {
         config: *config,
         num_parts: dataset.num_parts,

@@ -17,7 +17,7 @@ use artmesh::synth::SuiteKind;
 use serde::Serialize;
 
 use super::source::{SourceObject, SuiteSource};
-use crate::args::{SuiteObjects, context, fit_config, to_json};
+use crate::args::{BudgetArgs, SuiteObjects, context, to_json};
 use crate::output::{check_new_file, write_new_file};
 use crate::suite::CaptureSettings;
 
@@ -33,9 +33,9 @@ pub struct FitBenchArgs {
     which: String,
     #[command(flatten)]
     suite: SuiteObjects,
-    /// Override the preset's articulation steps.
-    #[arg(long)]
-    articulation_iterations: Option<u32>,
+    /// Overrides of the preset's budget (working size, views, iterations, face cap).
+    #[command(flatten)]
+    budget: BudgetArgs,
     /// How the joints use the dataset's full-resolution depth and part maps: settle (joints
     /// the measurements settle skip the photometric stages), seed (they seed every part's
     /// photometric stages), off (the paper's method) [default: settle; off for paper].
@@ -65,10 +65,7 @@ pub fn run(args: &FitBenchArgs) -> Result<String, String> {
         ));
     }
     let s = &args.suite;
-    let mut config = fit_config(&s.preset)?;
-    if let Some(n) = args.articulation_iterations {
-        config.articulation.iterations = n;
-    }
+    let mut config = args.budget.fit_config(&s.preset)?;
     if let Some(g) = &args.geometry {
         config.articulation.geometry = GeometryUse::parse(g).map_err(|e| e.to_string())?;
     }
@@ -110,10 +107,13 @@ fn log_object(o: &FitObject) {
     let m = &o.metrics;
     let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
     eprintln!(
-        "bench fit: {} ({} parts) {:.0} s  axis ang {}  axis pos {}  motion {}  CD-s {}  CD-m {}  types {}",
+        "bench fit: {} ({} parts) {:.0} s (+{:.0} s reading)  PSNR {:.1}/{:.1} dB  axis ang {}  axis pos {}  motion {}  CD-s {}  CD-m {}  types {}",
         o.id,
         o.parts,
         o.seconds,
+        o.load_s,
+        o.psnr[0],
+        o.psnr[1],
         f(m.axis_ang),
         f(m.axis_pos),
         f(m.part_motion),
@@ -136,6 +136,10 @@ pub struct FitObject {
     pub seconds: f64,
     pub reconstruct_s: f64,
     pub articulate_s: f64,
+    /// Seconds reading the dataset (decoding its images) before the fit.
+    pub load_s: f64,
+    /// Mean training-view PSNR (dB) of each state's reconstruction after its recovery.
+    pub psnr: [f64; 2],
     pub metrics: ObjectMetrics,
     pub joints: Vec<JointRecord>,
     pub warnings: Vec<String>,
@@ -216,9 +220,12 @@ pub fn fit_suite(
         if !super::selected(only, &object.id) {
             continue;
         }
+        let loading = Instant::now();
         let mut dataset = source.load(ctx, &object)?;
+        let load_s = loading.elapsed().as_secs_f64();
         degrade.apply(&mut dataset, 17);
-        let (done, mut fit) = fit_one(ctx, config, &dataset, &object)?;
+        let (mut done, mut fit) = fit_one(ctx, config, &dataset, &object)?;
+        done.load_s = load_s;
         let metrics = done.metrics.clone();
         log(&done);
         objects.push(done);
@@ -299,6 +306,11 @@ fn fit_one(
         seconds,
         reconstruct_s,
         articulate_s: seconds - reconstruct_s,
+        load_s: 0.0,
+        psnr: [0, 1].map(|i| {
+            let states = &fit.reconstruction.states;
+            states.get(i).map_or(f64::NAN, |s| s.psnr_recovered)
+        }),
         metrics: score(&fit, dataset, object)?,
         joints: artmesh::export::joint_records(&fit),
         warnings: fit.articulation.warnings.clone(),
