@@ -85,14 +85,14 @@ async function gpuSection() {
   const name = vendor ? `${vendor} — ${adapter.name}` : adapter.name;
   document.body.dataset.adapter = name;
   const software = adapter.device_type === "Cpu";
-  // A fast fit takes tens of minutes on a software adapter: start such a visitor at tiny, unless
+  // A fast fit takes many minutes on a software adapter: start such a visitor at tiny, unless
   // the address asks for a preset.
   const tiny = software && !params.get("preset") && choosePreset("tiny");
   document.body.dataset.software = String(software);
   show($("adapter"), `${name} (${software ? "software" : "hardware"} WebGPU)\n` +
     `largest storage binding ${(adapter.max_storage_buffer_binding_size / 2 ** 20).toFixed(0)} MiB, ` +
     `${adapter.max_compute_workgroups_per_dimension} workgroups per dimension` +
-    (software ? `\nA software adapter is slow: ${tiny ? "the tiny preset is chosen (a fast fit would take about half an hour)" : "use the tiny preset"}.` : ""), "ok");
+    (software ? `\nA software adapter is slow: ${tiny ? "the tiny preset is chosen (a fast fit would take many minutes)" : "use the tiny preset"}.` : ""), "ok");
   gpuOk = true;
   return true;
 }
