@@ -42,6 +42,8 @@ pub struct StateQuality {
     pub psnr_optimised: f64,
     pub psnr_remeshed: f64,
     pub psnr_recovered: f64,
+    /// Mean PSNR over the state's held-out views (none without test views).
+    pub psnr_test: Option<f64>,
     pub width: u32,
     pub height: u32,
     pub views: usize,
@@ -115,6 +117,7 @@ pub(crate) fn state_quality(
         psnr_optimised: state.psnr_optimised,
         psnr_remeshed: state.psnr_remeshed,
         psnr_recovered: state.psnr_recovered,
+        psnr_test: state.psnr_test,
         width: state.width,
         height: state.height,
         views: state.views,

@@ -128,8 +128,21 @@ impl<'a> Trainer<'a> {
         ctx: &GpuContext,
         settings: &RasterSettings,
     ) -> GpuResult<f64> {
+        self.mean_psnr_over(ctx, self.cameras, self.frames, settings)
+            .await
+    }
+
+    /// Mean PSNR with `settings` over `frames` seen from `cameras` (of the training views'
+    /// size: views the fit may not have seen, such as held-out ones).
+    pub(crate) async fn mean_psnr_over(
+        &mut self,
+        ctx: &GpuContext,
+        cameras: &[Camera],
+        frames: &[Frame],
+        settings: &RasterSettings,
+    ) -> GpuResult<f64> {
         let mut sum = 0.0;
-        for (camera, frame) in self.cameras.iter().zip(self.frames) {
+        for (camera, frame) in cameras.iter().zip(frames) {
             self.raster
                 .forward(ctx, &self.field, &mut self.state, camera, settings)
                 .await?;
@@ -140,7 +153,7 @@ impl<'a> Trainer<'a> {
                 &target_rgb(frame, settings.background),
             );
         }
-        Ok(sum / self.cameras.len().max(1) as f64)
+        Ok(sum / frames.len().max(1) as f64)
     }
 
     /// The current render of training view `view` and its target (composited on the

@@ -14,8 +14,8 @@
 use std::sync::atomic::{AtomicBool, AtomicU8, Ordering};
 use std::sync::mpsc;
 
-use super::{ReconstructionConfig, StateReconstruction, reconstruct_state};
-use crate::data::{Frame, State};
+use super::{ReconstructionConfig, StateReconstruction, StateViews, reconstruct_state};
+use crate::data::State;
 use crate::fit::observer::{Command, Observer, PAUSE_POLL_MS, Preview, Progress};
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 
@@ -126,11 +126,11 @@ fn play(heard: &mpsc::Receiver<Heard>, steering: &mut Steering) -> GpuResult<()>
     Ok(())
 }
 
-/// Reconstructs the start state from `frames[0]` and the end state from `frames[1]` at once
+/// Reconstructs the start state from `views[0]` and the end state from `views[1]` at once
 /// (see the module docs).
 pub(super) fn reconstruct_both(
     ctx: &GpuContext,
-    frames: [&[Frame]; 2],
+    views: &[StateViews; 2],
     num_parts: usize,
     config: &ReconstructionConfig,
     observer: &mut dyn Observer,
@@ -146,8 +146,16 @@ pub(super) fn reconstruct_both(
                 shared: &shared,
             };
             let ctx = &second;
-            let state =
-                reconstruct_state(ctx, State::End, frames[1], num_parts, config, &mut relay);
+            let [train, held_out] = [&views[1].train, &views[1].held_out];
+            let state = reconstruct_state(
+                ctx,
+                State::End,
+                train,
+                held_out,
+                num_parts,
+                config,
+                &mut relay,
+            );
             pollster::block_on(state)
         });
         let mut steering = Steering {
@@ -157,7 +165,8 @@ pub(super) fn reconstruct_both(
         let state = reconstruct_state(
             ctx,
             State::Start,
-            frames[0],
+            &views[0].train,
+            &views[0].held_out,
             num_parts,
             config,
             &mut steering,

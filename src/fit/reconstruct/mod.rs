@@ -52,21 +52,40 @@ pub fn training_views(
         .map(|v| &v.frames)
         .filter(|f| !f.is_empty())
         .ok_or(NoTrainingViews(state))?;
-    let n = frames.len();
-    let take = if config.max_views == 0 {
-        n
-    } else {
-        config.max_views.min(n)
+    Ok(working_views(frames, config.max_views, config.max_size))
+}
+
+/// One state's views at the working size: those fitted on and those held out.
+pub(crate) struct StateViews {
+    pub train: Vec<Frame>,
+    pub held_out: Vec<Frame>,
+}
+
+/// The held-out (test) views of `state`, all of them, downsampled as the training views are;
+/// empty when the dataset has none.
+pub fn test_views(dataset: &Dataset, state: State, config: &ReconstructionConfig) -> Vec<Frame> {
+    dataset
+        .views(state, Split::Test)
+        .map_or(Vec::new(), |v| working_views(&v.frames, 0, config.max_size))
+}
+
+/// At most `max_views` of `frames` (0 = all), evenly spaced, downsampled by the integer factor
+/// that brings the longer side to `max_size` or under (0 = full size).
+fn working_views(frames: &[Frame], max_views: usize, max_size: u32) -> Vec<Frame> {
+    let Some(first) = frames.first() else {
+        return Vec::new();
     };
-    let longest = frames[0].rgba.width.max(frames[0].rgba.height);
-    let factor = if config.max_size == 0 {
+    let n = frames.len();
+    let take = if max_views == 0 { n } else { max_views.min(n) };
+    let longest = first.rgba.width.max(first.rgba.height);
+    let factor = if max_size == 0 {
         1
     } else {
-        longest.div_ceil(config.max_size).max(1)
+        longest.div_ceil(max_size).max(1)
     };
-    Ok((0..take)
+    (0..take)
         .map(|i| downsample_frame(&frames[i * n / take], factor))
-        .collect())
+        .collect()
 }
 
 /// Reconstructs both states of `dataset`: natively at once ([`both`]), in the browser in turn.
@@ -76,18 +95,23 @@ pub async fn reconstruct(
     config: &ReconstructionConfig,
     observer: &mut dyn Observer,
 ) -> GpuResult<Reconstruction> {
-    let views = |state| {
-        training_views(dataset, state, config).map_err(|e| GpuError::InvalidInput(e.to_string()))
+    let views = |state| -> GpuResult<StateViews> {
+        Ok(StateViews {
+            train: training_views(dataset, state, config)
+                .map_err(|e| GpuError::InvalidInput(e.to_string()))?,
+            held_out: test_views(dataset, state, config),
+        })
     };
-    let frames = [views(State::Start)?, views(State::End)?];
+    let views = [views(State::Start)?, views(State::End)?];
     let k = dataset.num_parts;
     #[cfg(not(target_arch = "wasm32"))]
-    let states = both::reconstruct_both(ctx, [&frames[0], &frames[1]], k, config, observer)?.into();
+    let states = both::reconstruct_both(ctx, &views, k, config, observer)?.into();
     #[cfg(target_arch = "wasm32")]
     let states = {
         let mut states = Vec::new();
-        for (state, frames) in State::ALL.into_iter().zip(&frames) {
-            states.push(reconstruct_state(ctx, state, frames, k, config, observer).await?);
+        for (state, v) in State::ALL.into_iter().zip(&views) {
+            let rec = reconstruct_state(ctx, state, &v.train, &v.held_out, k, config, observer);
+            states.push(rec.await?);
         }
         states
     };

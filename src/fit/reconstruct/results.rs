@@ -104,6 +104,9 @@ pub struct StateReconstruction {
     pub psnr_optimised: f64,
     pub psnr_remeshed: f64,
     pub psnr_recovered: f64,
+    /// Mean PSNR of the final mesh over the state's held-out (test) views at the working size,
+    /// rendered as in training; `None` when the dataset has no test views of the state.
+    pub psnr_test: Option<f64>,
     pub curve: Vec<CurvePoint>,
     pub times: PhaseTimes,
     /// Size and number of the training views used.

@@ -89,11 +89,13 @@ fn sizes(field: &MeshField) -> (usize, usize) {
     (field.num_vertices(), field.faces.len())
 }
 
-/// Reconstructs one state from its training `frames` (see the module docs).
+/// Reconstructs one state from its training `frames` (see the module docs), and measures the
+/// result on its `held_out` views (may be empty) at the end.
 pub async fn reconstruct_state(
     ctx: &GpuContext,
     state: State,
     frames: &[Frame],
+    held_out: &[Frame],
     num_parts: usize,
     config: &ReconstructionConfig,
     observer: &mut dyn Observer,
@@ -130,6 +132,9 @@ pub async fn reconstruct_state(
     let optimised = optimise(&mut run, &mut trainer, &field, frames.len(), px_per_m).await?;
     let (remeshed, remesh_stats) = remesh_stage(&mut run, &optimised.field).await?;
     let recovered = recover(&mut run, &mut trainer, &remeshed).await?;
+    let recovery = config.recovery();
+    let last = recovery.settings_at(recovery.iterations);
+    let psnr_test = held_out_psnr(ctx, &mut trainer, held_out, (width, height), &last).await?;
 
     let field = recovered.field;
     let parts = harden_parts(&field);
@@ -155,6 +160,7 @@ pub async fn reconstruct_state(
         psnr_optimised: optimised.psnr,
         psnr_remeshed: recovered.psnr_remeshed,
         psnr_recovered: recovered.psnr_recovered,
+        psnr_test,
         curve: optimised.curve,
         times: run.times,
         width,
@@ -345,4 +351,24 @@ async fn recover(
         psnr_remeshed,
         psnr_recovered,
     })
+}
+
+/// Mean PSNR of the field in `trainer` over `held_out` (views it was not fitted on) with
+/// `settings`; `None` without such views or when their size is not the training views'.
+async fn held_out_psnr(
+    ctx: &GpuContext,
+    trainer: &mut Trainer<'_>,
+    held_out: &[Frame],
+    (width, height): (u32, u32),
+    settings: &RasterSettings,
+) -> GpuResult<Option<f64>> {
+    let sized = |f: &Frame| (f.rgba.width, f.rgba.height) == (width, height);
+    if held_out.is_empty() || !held_out.iter().all(sized) {
+        return Ok(None);
+    }
+    let cameras: Vec<Camera> = held_out.iter().map(|f| f.camera).collect();
+    let psnr = trainer
+        .mean_psnr_over(ctx, &cameras, held_out, settings)
+        .await?;
+    Ok(Some(psnr))
 }

@@ -106,14 +106,17 @@ pub fn run(args: &FitBenchArgs) -> Result<String, String> {
 fn log_object(o: &FitObject) {
     let m = &o.metrics;
     let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+    let f1 = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.1}"));
     eprintln!(
-        "bench fit: {} ({} parts) {:.0} s (+{:.0} s reading)  PSNR {:.1}/{:.1} dB  axis ang {}  axis pos {}  motion {}  CD-s {}  CD-m {}  types {}",
+        "bench fit: {} ({} parts) {:.0} s (+{:.0} s reading)  PSNR {:.1}/{:.1} dB (test {}/{})  axis ang {}  axis pos {}  motion {}  CD-s {}  CD-m {}  types {}",
         o.id,
         o.parts,
         o.seconds,
         o.load_s,
         o.psnr[0],
         o.psnr[1],
+        f1(o.psnr_test[0]),
+        f1(o.psnr_test[1]),
         f(m.axis_ang),
         f(m.axis_pos),
         f(m.part_motion),
@@ -140,6 +143,8 @@ pub struct FitObject {
     pub load_s: f64,
     /// Mean training-view PSNR (dB) of each state's reconstruction after its recovery.
     pub psnr: [f64; 2],
+    /// The same over each state's held-out (test) views.
+    pub psnr_test: [Option<f64>; 2],
     pub metrics: ObjectMetrics,
     pub joints: Vec<JointRecord>,
     pub warnings: Vec<String>,
@@ -311,6 +316,7 @@ fn fit_one(
             let states = &fit.reconstruction.states;
             states.get(i).map_or(f64::NAN, |s| s.psnr_recovered)
         }),
+        psnr_test: [0, 1].map(|i| fit.reconstruction.states.get(i).and_then(|s| s.psnr_test)),
         metrics: score(&fit, dataset, object)?,
         joints: artmesh::export::joint_records(&fit),
         warnings: fit.articulation.warnings.clone(),
