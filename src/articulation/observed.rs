@@ -306,6 +306,39 @@ pub fn observe_dataset(
     ))
 }
 
+impl PartCloud {
+    /// The cloud averaged again in coarser voxels (the two sides of a thin part kept apart) until
+    /// it has at most `max_points` points; itself if it already has.
+    pub fn coarsened(&self, max_points: usize) -> PartCloud {
+        if self.points.len() <= max_points {
+            return self.clone();
+        }
+        let samples: Vec<Sample> = (0..self.points.len())
+            .map(|i| Sample {
+                part: 0,
+                point: self.points[i],
+                normal: self.normals[i],
+                color: self.colors[i],
+            })
+            .collect();
+        let refs: Vec<&Sample> = samples.iter().collect();
+        let defaults = CloudOptions::default();
+        let mut edge =
+            (extent(self.points.iter().copied()) / defaults.voxels_across).max(defaults.min_voxel);
+        loop {
+            edge *= 1.25;
+            let cloud = voxelise(&refs, edge);
+            if cloud.points.len() <= max_points.max(1) {
+                return PartCloud {
+                    pixels: self.pixels,
+                    labelled: self.labelled,
+                    ..cloud
+                };
+            }
+        }
+    }
+}
+
 impl ObservedState {
     /// The points of every part but `part`, at most `max` of them (evenly thinned): what a
     /// joint of `part` attaches to.

@@ -8,7 +8,7 @@ use serde::Serialize;
 use super::articulate::{Articulation, ArticulationConfig, articulate};
 use super::observer::{Observer, Phase, Progress};
 use super::preset::{BudgetOverrides, Preset};
-use super::reconstruct::{Reconstruction, ReconstructionConfig, reconstruct};
+use super::reconstruct::{Reconstruction, ReconstructionConfig, SurfaceSource, reconstruct};
 use crate::data::{Dataset, GroundTruth, State};
 use crate::gpu::{GpuContext, GpuResult};
 
@@ -41,7 +41,12 @@ impl FitConfig {
     /// per state (measured at fast: 75, 40 and 89 ms per step with one view per refinement step).
     pub fn fraction_done(&self, event: &Progress) -> f64 {
         let rec = &self.reconstruction;
-        let (fit, recover) = (rec.fit.iterations, rec.recovery_iterations);
+        // Measured surfaces skip the optimisation (where every part was measured, as usual).
+        let fit = match rec.surface {
+            SurfaceSource::Measured => 0,
+            SurfaceSource::Optimised => rec.fit.iterations,
+        };
+        let recover = rec.recovery_iterations;
         let per_state = 2.0 * f64::from(fit + recover);
         let art = &self.articulation;
         let decide = art.decision_step();
@@ -66,7 +71,8 @@ impl FitConfig {
                 + 2.0
                     * f64::from(match event.phase {
                         Phase::Initialise => 0,
-                        Phase::Optimise | Phase::Densify => event.iteration,
+                        // (Bounded: a measured fit that had to optimise stands still meanwhile.)
+                        Phase::Optimise | Phase::Densify => event.iteration.min(fit),
                         Phase::Remesh => fit,
                         Phase::Recover => fit + event.iteration,
                         _ => fit + recover,

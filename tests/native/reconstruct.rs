@@ -8,7 +8,7 @@ use artmesh::eval::mesh_quality::reconstruction_failures;
 use artmesh::fit::observer::{Phase, Progress, Unobserved};
 use artmesh::fit::preset::Preset;
 use artmesh::fit::reconstruct::{
-    ReconstructionConfig, RemeshMode, reconstruct, reconstruct_state, training_views,
+    ReconstructionConfig, RemeshMode, SurfaceSource, reconstruct, reconstruct_state, state_views,
 };
 use artmesh::fixtures::object::{tiny_laptop, tiny_reconstruction};
 use artmesh::mesh::topology::cross_part_faces;
@@ -69,16 +69,25 @@ fn global_remeshing_builds_faces_across_parts_and_the_report_counts_them() {
 fn both_states_at_once_come_out_as_each_alone_and_are_heard_in_turn() {
     let ctx = context();
     let dataset = pollster::block_on(tiny_laptop(&ctx)).unwrap();
-    let config = ReconstructionConfig::preset(Preset::Tiny);
+    // With the measured surfaces, so that each state is also given its own measured clouds.
+    let config = ReconstructionConfig {
+        surface: SurfaceSource::Measured,
+        ..ReconstructionConfig::preset(Preset::Tiny)
+    };
     let mut events: Vec<Progress> = Vec::new();
     let mut listen = |e: &Progress| events.push(*e);
     let both = pollster::block_on(reconstruct(&ctx, &dataset, &config, &mut listen)).unwrap();
-    for (state, together) in State::ALL.into_iter().zip(&both.states) {
-        let frames = training_views(&dataset, state, &config).unwrap();
+    let views = state_views(&dataset, &config).unwrap();
+    for ((state, together), mut views) in State::ALL.into_iter().zip(&both.states).zip(views) {
+        assert!(
+            views.measured.is_some(),
+            "{state:?} has no measured surfaces"
+        );
         let k = dataset.num_parts;
         let mut quiet = Unobserved;
         // Held out here: the training views themselves, so the held-out PSNR is the training one.
-        let alone = reconstruct_state(&ctx, state, &frames, &frames, k, &config, &mut quiet);
+        views.held_out = views.train.clone();
+        let alone = reconstruct_state(&ctx, state, &views, k, &config, &mut quiet);
         let alone = pollster::block_on(alone).unwrap();
         assert!(together.field == alone.field, "{state:?} differs");
         assert_eq!(together.psnr_recovered, alone.psnr_recovered);

@@ -3,7 +3,7 @@
 
 use artmesh::fit::object::FitConfig;
 use artmesh::fit::preset::{BudgetOverrides, Preset};
-use artmesh::fit::reconstruct::{ReconstructionConfig, RemeshMode};
+use artmesh::fit::reconstruct::{ReconstructionConfig, RemeshMode, SurfaceSource};
 use artmesh::gpu::GpuContext;
 use artmesh::render::RenderSpec;
 
@@ -105,6 +105,11 @@ pub struct BudgetArgs {
     /// Override the preset's articulation steps.
     #[arg(long)]
     articulation_iterations: Option<u32>,
+    /// Where the part surfaces come from: measured (every training view's full-resolution depth
+    /// and part maps, remeshed) or optimised (the photometric fit's vertices, the paper's way)
+    /// [default: measured for fast, optimised for tiny and paper].
+    #[arg(long, value_parser = ["measured", "optimised"])]
+    surface: Option<String>,
 }
 
 impl BudgetArgs {
@@ -118,10 +123,16 @@ impl BudgetArgs {
             max_faces: self.max_faces,
             articulation_iterations: self.articulation_iterations,
         };
-        Ok(FitConfig::budgeted(
+        let mut config = FitConfig::budgeted(
             Preset::parse(preset).map_err(|e| e.to_string())?,
             &overrides,
-        ))
+        );
+        match self.surface.as_deref() {
+            Some("measured") => config.reconstruction.surface = SurfaceSource::Measured,
+            Some(_) => config.reconstruction.surface = SurfaceSource::Optimised,
+            None => {}
+        }
+        Ok(config)
     }
 }
 

@@ -30,12 +30,31 @@ pub(super) struct Decision {
 /// call on the threshold, and a tie leaves the measurements to decide.
 const BAKE_OFF_WEIGHT: f64 = 10.0;
 
+/// A revolute candidate turning further than this (degrees) that the measurements cannot tell
+/// from a slide is a part symmetric under a half turn (a window pane, a flat panel): a half turn
+/// maps it onto itself shifted, so photometry ties too. No joint of either suite turns past 86°.
+const HALF_TURN_DEGREES: f64 = 150.0;
+
 /// The joint type from both models' evidence: ln(prismatic / (slack × revolute)) of the measured
 /// residuals (none when the motion is not observable there) plus [`BAKE_OFF_WEIGHT`] times
 /// ln(prismatic / revolute) of the bake-off's losses; positive (or zero) is revolute, as the
-/// paper breaks ties.
-fn combined_kind(g: &GeometricJoint, revolute_loss: f64, prismatic_loss: f64) -> JointKind {
-    use crate::articulation::geometric::PRISMATIC_SLACK;
+/// paper breaks ties. A near half turn the measurements cannot tell from a slide is a slide
+/// ([`HALF_TURN_DEGREES`]).
+fn combined_kind(
+    g: &GeometricJoint,
+    revolute: &PartMotion,
+    revolute_loss: f64,
+    prismatic_loss: f64,
+) -> JointKind {
+    use crate::articulation::geometric::{PRISMATIC_SLACK, SMALL_MARGIN};
+    let (_, angle) = revolute.rotation.to_axis_angle();
+    let turn = angle
+        .abs()
+        .min(std::f64::consts::TAU - angle.abs())
+        .to_degrees();
+    if g.margin < SMALL_MARGIN && turn > HALF_TURN_DEGREES {
+        return JointKind::Prismatic;
+    }
     let measured = if g.observable {
         (g.prismatic_residual / (PRISMATIC_SLACK * g.revolute_residual.max(1e-9))).ln()
     } else {
@@ -114,7 +133,7 @@ pub(super) async fn bake_off(
         };
         // Both models' evidence: the measured residuals' and the bake-off's log ratios.
         let kind = match &measured.joints[part] {
-            Some(g) if pixels > 0 => combined_kind(g, rot, trans),
+            Some(g) if pixels > 0 => combined_kind(g, &candidates.revolute[part], rot, trans),
             Some(g) if g.observable => g.kind,
             _ => kind,
         };
@@ -141,4 +160,53 @@ pub(super) async fn bake_off(
         motions,
     };
     Ok((decision, now_seconds() - t_bake))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A measured joint whose residuals (mm) barely favour the revolute candidate `revolute`.
+    fn tied(revolute: PartMotion) -> GeometricJoint {
+        GeometricJoint {
+            revolute,
+            prismatic: PartMotion::prismatic(DVec3::X * 0.1),
+            revolute_residual: 0.62,
+            prismatic_residual: 0.72,
+            identity_residual: 8.5,
+            kind: JointKind::Revolute,
+            margin: 0.2,
+            observable: true,
+            points: [5000, 5000],
+        }
+    }
+
+    #[test]
+    fn a_near_half_turn_the_measurements_cannot_tell_from_a_slide_is_a_slide() {
+        let turn = |deg: f64| PartMotion::revolute(DVec3::Z, DVec3::ZERO, deg.to_radians());
+        // The bake-off leans revolute by 1 % (the window pane of the quick suite).
+        let (rot, trans) = (1.050, 1.062);
+        for deg in [179.99, -175.0, 155.0] {
+            let g = tied(turn(deg));
+            assert_eq!(
+                combined_kind(&g, &g.revolute, rot, trans),
+                JointKind::Prismatic,
+                "{deg}°"
+            );
+        }
+        // An ordinary door turn keeps the evidence's verdict, and so does a settled half turn.
+        let door = tied(turn(80.0));
+        assert_eq!(
+            combined_kind(&door, &door.revolute, rot, trans),
+            JointKind::Revolute
+        );
+        let settled = GeometricJoint {
+            margin: 2.0,
+            ..tied(turn(179.0))
+        };
+        assert_eq!(
+            combined_kind(&settled, &settled.revolute, rot, trans),
+            JointKind::Revolute
+        );
+    }
 }

@@ -5,7 +5,7 @@
 
 use super::config::{ArticulationConfig, GeometryUse};
 use crate::articulation::geometric::{Anchor, GeometricJoint, fit_joint};
-use crate::articulation::observed::{ObservedState, observe_dataset};
+use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
 use crate::data::{Dataset, Split, State};
 use crate::gpu::{GpuError, GpuResult};
 
@@ -25,13 +25,23 @@ pub(super) struct Measured {
 
 /// Measures the joints of `k` parts from the training views, adding what a user should know
 /// to `warnings`.
+/// `sampled`: both states' training clouds if the reconstruction already sampled them, with the
+/// options it sampled them with (reused when those are `config`'s).
 pub(super) fn measure(
     dataset: &Dataset,
     config: &ArticulationConfig,
     k: usize,
+    sampled: Option<&(CloudOptions, [ObservedState; 2])>,
     warnings: &mut Vec<String>,
 ) -> GpuResult<Measured> {
-    let train_clouds = observe(dataset, config, Split::Train);
+    let train_clouds = match sampled {
+        Some((options, clouds))
+            if *options == config.clouds && config.geometry != GeometryUse::Off =>
+        {
+            Some(clouds.clone())
+        }
+        _ => observe(dataset, config, Split::Train),
+    };
     if let Some(clouds) = &train_clouds {
         measurement_warnings(clouds, warnings)?;
         let has_test_views = [State::Start, State::End]

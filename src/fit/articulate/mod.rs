@@ -108,7 +108,7 @@ pub async fn articulate(
 
     // Seeds: the reconstructions', then the measured joints where there are.
     let seeds = reconstruction_seeds(s1, s2, k, &mut warnings);
-    let measured = measure(dataset, config, k, &mut warnings)?;
+    let measured = measure(dataset, config, k, rec.train_clouds.as_ref(), &mut warnings)?;
     let mut candidates = Candidates::seeded(seeds, &measured);
     times.setup_s = now_seconds() - t0;
 

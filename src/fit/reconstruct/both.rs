@@ -146,16 +146,8 @@ pub(super) fn reconstruct_both(
                 shared: &shared,
             };
             let ctx = &second;
-            let [train, held_out] = [&views[1].train, &views[1].held_out];
-            let state = reconstruct_state(
-                ctx,
-                State::End,
-                train,
-                held_out,
-                num_parts,
-                config,
-                &mut relay,
-            );
+            let state =
+                reconstruct_state(ctx, State::End, &views[1], num_parts, config, &mut relay);
             pollster::block_on(state)
         });
         let mut steering = Steering {
@@ -165,8 +157,7 @@ pub(super) fn reconstruct_both(
         let state = reconstruct_state(
             ctx,
             State::Start,
-            &views[0].train,
-            &views[0].held_out,
+            &views[0],
             num_parts,
             config,
             &mut steering,

@@ -27,11 +27,12 @@ mod remesh;
 mod results;
 mod state;
 
-pub use config::{DensifyConfig, ReconstructionConfig, RemeshMode};
+pub use config::{DensifyConfig, ReconstructionConfig, RemeshMode, SurfaceSource};
 pub use results::{PhaseTimes, Reconstruction, RemeshStats, StateReconstruction};
 pub use state::reconstruct_state;
 
 use super::views::downsample_frame;
+use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
 use crate::data::{Dataset, Frame, Split, State};
 use crate::fit::observer::Observer;
 use crate::gpu::{GpuContext, GpuError, GpuResult};
@@ -55,10 +56,13 @@ pub fn training_views(
     Ok(working_views(frames, config.max_views, config.max_size))
 }
 
-/// One state's views at the working size: those fitted on and those held out.
-pub(crate) struct StateViews {
+/// What one state's reconstruction is given: its views at the working size (those fitted on and
+/// those held out), and its parts' surfaces as measured at full resolution, when the config asks
+/// for them (see [`SurfaceSource`]).
+pub struct StateViews {
     pub train: Vec<Frame>,
     pub held_out: Vec<Frame>,
+    pub measured: Option<ObservedState>,
 }
 
 /// The held-out (test) views of `state`, all of them, downsampled as the training views are;
@@ -88,6 +92,33 @@ fn working_views(frames: &[Frame], max_views: usize, max_size: u32) -> Vec<Frame
         .collect()
 }
 
+/// How the measured surfaces are sampled: as the measured joints sample them, so the
+/// articulation phase can reuse them.
+fn surface_clouds() -> CloudOptions {
+    CloudOptions::default()
+}
+
+/// Both states' [`StateViews`] of `dataset` under `config`, start state first: what
+/// [`reconstruct`] fits.
+pub fn state_views(dataset: &Dataset, config: &ReconstructionConfig) -> GpuResult<[StateViews; 2]> {
+    // Both states at once: a part's voxel size is the same in both.
+    let measured = (config.surface == SurfaceSource::Measured)
+        .then(|| observe_dataset(dataset, Split::Train, &surface_clouds()))
+        .flatten();
+    let mut measured = measured
+        .map(|[s, e]| [Some(s), Some(e)])
+        .unwrap_or_default();
+    let mut views = |state: State| -> GpuResult<StateViews> {
+        Ok(StateViews {
+            train: training_views(dataset, state, config)
+                .map_err(|e| GpuError::InvalidInput(e.to_string()))?,
+            held_out: test_views(dataset, state, config),
+            measured: measured[state.index()].take(),
+        })
+    };
+    Ok([views(State::Start)?, views(State::End)?])
+}
+
 /// Reconstructs both states of `dataset`: natively at once ([`both`]), in the browser in turn.
 pub async fn reconstruct(
     ctx: &GpuContext,
@@ -95,14 +126,7 @@ pub async fn reconstruct(
     config: &ReconstructionConfig,
     observer: &mut dyn Observer,
 ) -> GpuResult<Reconstruction> {
-    let views = |state| -> GpuResult<StateViews> {
-        Ok(StateViews {
-            train: training_views(dataset, state, config)
-                .map_err(|e| GpuError::InvalidInput(e.to_string()))?,
-            held_out: test_views(dataset, state, config),
-        })
-    };
-    let views = [views(State::Start)?, views(State::End)?];
+    let views = state_views(dataset, config)?;
     let k = dataset.num_parts;
     #[cfg(not(target_arch = "wasm32"))]
     let states = both::reconstruct_both(ctx, &views, k, config, observer)?.into();
@@ -110,14 +134,19 @@ pub async fn reconstruct(
     let states = {
         let mut states = Vec::new();
         for (state, v) in State::ALL.into_iter().zip(&views) {
-            let rec = reconstruct_state(ctx, state, &v.train, &v.held_out, k, config, observer);
+            let rec = reconstruct_state(ctx, state, v, k, config, observer);
             states.push(rec.await?);
         }
         states
+    };
+    let train_clouds = match views.map(|v| v.measured) {
+        [Some(start), Some(end)] => Some((surface_clouds(), [start, end])),
+        _ => None,
     };
     Ok(Reconstruction {
         config: *config,
         num_parts: dataset.num_parts,
         states,
+        train_clouds,
     })
 }

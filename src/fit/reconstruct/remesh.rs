@@ -4,17 +4,26 @@
 
 use glam::Vec3;
 
-use super::config::{ReconstructionConfig, RemeshMode};
+use super::config::{ReconstructionConfig, RemeshMode, SurfaceSource};
 use super::results::RemeshStats;
+use crate::articulation::observed::ObservedState;
 use crate::mesh::topology::{
     compact, cross_part_faces, drop_small_components, face_part, median_edge, thin_vertices,
     vertex_normals,
 };
 use crate::mesh::{harden_parts, part_aware_remesh, restricted_delaunay};
-use crate::raster::MeshField;
+use crate::raster::{MeshField, SH_FLOATS};
 
-/// Hardened labels, new faces and what happened, for `field` remeshed with `config`'s mode.
-pub(super) fn remesh(field: &MeshField, config: &ReconstructionConfig) -> (MeshField, RemeshStats) {
+/// Fewer measured points than this and a part keeps its optimised vertices.
+const MIN_MEASURED_POINTS: usize = 32;
+
+/// Hardened labels, new faces and what happened, for `field` remeshed with `config`'s mode, over
+/// the `measured` part surfaces where given (see [`SurfaceSource::Measured`]).
+pub(super) fn remesh(
+    field: &MeshField,
+    measured: Option<&ObservedState>,
+    config: &ReconstructionConfig,
+) -> (MeshField, RemeshStats) {
     let parts = harden_parts(field);
     let normals = vertex_normals(&field.positions, &field.faces);
     let mut stats = RemeshStats {
@@ -34,6 +43,13 @@ pub(super) fn remesh(field: &MeshField, config: &ReconstructionConfig) -> (MeshF
         thin_vertices(&used, &used_normals, &used_parts, cell)
     } else {
         (used, used_normals)
+    };
+    let (used, used_normals) = match measured {
+        Some(m) if config.surface == SurfaceSource::Measured => {
+            // About two faces per vertex: the preset's face cap bounds the measured points.
+            with_measured_parts(&used, &used_normals, m, config.densify.max_faces / 2)
+        }
+        _ => (used, used_normals),
     };
     let used_parts = harden_parts(&used);
     let faces = match config.remesh {
@@ -71,7 +87,7 @@ pub(super) fn remesh(field: &MeshField, config: &ReconstructionConfig) -> (MeshF
         .map(|(f, _)| *f)
         .collect();
     let (mut out, _) = compact(&used, faces);
-    stats.unused_vertices = field.num_vertices() - out.num_vertices();
+    stats.unused_vertices = field.num_vertices().saturating_sub(out.num_vertices());
     // Hardened logits: the label strongly, so renders of part logits show the labels.
     let labels = harden_parts(&out);
     let p = out.num_parts;
@@ -81,4 +97,141 @@ pub(super) fn remesh(field: &MeshField, config: &ReconstructionConfig) -> (MeshF
         logits[k as usize] = 10.0;
     }
     (out, stats)
+}
+
+/// Whether `measured` has enough points of each of `num_parts` parts to replace them all.
+pub(super) fn measures_every_part(measured: &ObservedState, num_parts: usize) -> bool {
+    (0..num_parts).all(|k| measures_part(measured, k))
+}
+
+/// Whether `measured` has enough points of part `k` to replace its optimised vertices.
+fn measures_part(measured: &ObservedState, k: usize) -> bool {
+    measured
+        .parts
+        .get(k)
+        .is_some_and(|c| c.points.len() >= MIN_MEASURED_POINTS)
+}
+
+/// `thinned`'s vertices with every part that `measured` has enough points of replaced by those
+/// points (their normals and mean pixel colours; opacity and logits hardened to the part),
+/// coarsened where the measured parts have more than `max_points` points in all (each to its
+/// share).
+fn with_measured_parts(
+    thinned: &MeshField,
+    normals: &[Vec3],
+    measured: &ObservedState,
+    max_points: usize,
+) -> (MeshField, Vec<Vec3>) {
+    let parts = harden_parts(thinned);
+    let p = thinned.num_parts;
+    let replaced = |k: usize| measures_part(measured, k);
+    let kept: Vec<usize> = (0..thinned.num_vertices())
+        .filter(|&v| !replaced(parts[v] as usize))
+        .collect();
+    let mut positions: Vec<Vec3> = kept.iter().map(|&v| thinned.positions[v]).collect();
+    let mut out_normals: Vec<Vec3> = kept.iter().map(|&v| normals[v]).collect();
+    let mut colors = Vec::new();
+    let mut labels = Vec::new();
+    let total: usize = (0..p)
+        .filter(|&k| replaced(k))
+        .map(|k| measured.parts[k].points.len())
+        .sum();
+    for k in (0..p).filter(|&k| replaced(k)) {
+        let own = measured.parts[k].points.len();
+        let share = (max_points as f64 * own as f64 / total.max(1) as f64) as usize;
+        let cloud = &measured.parts[k].coarsened(share.max(MIN_MEASURED_POINTS));
+        positions.extend(&cloud.points);
+        out_normals.extend(&cloud.normals);
+        colors.extend(&cloud.colors);
+        labels.extend(std::iter::repeat_n(k, cloud.points.len()));
+    }
+    let mut out = MeshField::new(positions, Vec::new(), p, 4.0);
+    for (i, &v) in kept.iter().enumerate() {
+        out.sh[i * SH_FLOATS..(i + 1) * SH_FLOATS]
+            .copy_from_slice(&thinned.sh[v * SH_FLOATS..(v + 1) * SH_FLOATS]);
+        out.opacity[i] = thinned.opacity[v];
+        out.part_logits[i * p..(i + 1) * p]
+            .copy_from_slice(&thinned.part_logits[v * p..(v + 1) * p]);
+    }
+    for (j, (&color, &k)) in colors.iter().zip(&labels).enumerate() {
+        let v = kept.len() + j;
+        out.set_color(v, color);
+        out.part_logits[v * p + k] = 10.0;
+    }
+    (out, out_normals)
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::articulation::observed::PartCloud;
+
+    /// A flat square of `n`² points at height `z`, normals up.
+    fn square(n: usize, z: f32) -> PartCloud {
+        let points: Vec<Vec3> = (0..n * n)
+            // Jittered: a regular grid's cocircular points have no unique Delaunay umbrellas.
+            .map(|i| {
+                let jitter = ((i * 7919) % 13) as f32 * 2e-4;
+                Vec3::new(
+                    (i % n) as f32 * 0.01 + jitter,
+                    (i / n) as f32 * 0.01 - jitter,
+                    z,
+                )
+            })
+            .collect();
+        PartCloud {
+            normals: vec![Vec3::Z; points.len()],
+            colors: vec![Vec3::new(0.8, 0.2, 0.1); points.len()],
+            pixels: points.len(),
+            labelled: points.len(),
+            points,
+        }
+    }
+
+    #[test]
+    fn measured_parts_replace_the_optimised_ones_that_have_enough_points() {
+        // Optimised: part 0 at z = 0, part 1 at z = 1 (three vertices each).
+        let positions = [0.0f32, 0.0, 0.0, 1.0, 1.0, 1.0].map(|z| Vec3::new(0.0, 0.0, z));
+        let mut field = MeshField::new(positions.to_vec(), Vec::new(), 2, 0.0);
+        for v in 0..6 {
+            field.part_logits[2 * v + v / 3] = 5.0;
+        }
+        let normals = vec![Vec3::Z; 6];
+        // Measured: part 0 densely at z = 0.5, part 1 with too few points to trust.
+        let measured = ObservedState {
+            parts: vec![square(10, 0.5), square(3, 2.0)],
+            views_with_depth: 1,
+            views: 1,
+            stride: 1,
+        };
+        let (out, out_normals) = with_measured_parts(&field, &normals, &measured, 1000);
+        assert_eq!(out.num_vertices(), 3 + 100);
+        assert_eq!(out_normals.len(), out.num_vertices());
+        let parts = harden_parts(&out);
+        for (position, part) in out.positions.iter().zip(&parts) {
+            let z = position.z;
+            match part {
+                0 => assert_eq!(z, 0.5, "part 0 is measured"),
+                _ => assert_eq!(z, 1.0, "part 1 keeps its optimised vertices"),
+            }
+        }
+        assert_eq!(parts.iter().filter(|&&k| k == 0).count(), 100);
+        let c = out.dc_color(3 + 7);
+        assert!((c - Vec3::new(0.8, 0.2, 0.1)).length() < 1e-5, "{c}");
+        // Over a budget, the measured parts are coarsened to it.
+        let (coarse, _) = with_measured_parts(&field, &normals, &measured, 40);
+        let coarse_parts = harden_parts(&coarse);
+        let measured_points = coarse_parts.iter().filter(|&&k| k == 0).count();
+        assert!((9..=40).contains(&measured_points), "{measured_points}");
+        // And they remesh into a surface over the measured points.
+        let config = ReconstructionConfig {
+            surface: SurfaceSource::Measured,
+            ..ReconstructionConfig::preset(crate::fit::preset::Preset::Tiny)
+        };
+        let (remeshed, stats) = remesh(&field, Some(&measured), &config);
+        assert_eq!(stats.cross_part_faces, 0);
+        assert!(remeshed.faces.len() > 100, "{} faces", remeshed.faces.len());
+    }
 }

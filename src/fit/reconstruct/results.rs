@@ -1,6 +1,7 @@
 //! What the reconstruction of a state produces: the final field and part meshes, what the
 //! densification and remeshing did, the PSNR after each stage and the time each took.
 
+use crate::articulation::observed::{CloudOptions, ObservedState};
 use serde::Serialize;
 
 use super::config::{ReconstructionConfig, RemeshMode};
@@ -121,6 +122,10 @@ pub struct Reconstruction {
     pub config: ReconstructionConfig,
     pub num_parts: usize,
     pub states: Vec<StateReconstruction>,
+    /// Both states' measured part surfaces from the training views, when the surfaces were
+    /// measured, with the options they were sampled with (the articulation's measured joints
+    /// reuse them rather than sample them again).
+    pub train_clouds: Option<(CloudOptions, [ObservedState; 2])>,
 }
 
 impl Reconstruction {

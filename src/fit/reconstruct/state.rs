@@ -2,14 +2,17 @@
 //! densification and pruning, harden and remesh, recover with the topology fixed. Each stage
 //! reports its [`Progress`] and lets the observer pause or cancel at its checkpoints.
 
+use super::StateViews;
 use super::config::ReconstructionConfig;
+use super::config::SurfaceSource;
 use super::densify::{densify_and_prune, pixels_per_metre};
-use super::remesh::remesh;
+use super::remesh::{measures_every_part, remesh};
 use super::results::{PhaseTimes, RemeshStats, StateReconstruction};
+use crate::articulation::observed::ObservedState;
 use crate::data::{Camera, Frame, State};
 use crate::fit::init::initial_field;
 use crate::fit::observer::{Observer, Phase, Progress, checkpoint};
-use crate::fit::photometric::{CurvePoint, Trainer};
+use crate::fit::photometric::{CurvePoint, PhotometricConfig, Trainer};
 use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
 use crate::mesh::{harden_parts, part_meshes};
 use crate::raster::{MeshField, RasterSettings};
@@ -89,18 +92,31 @@ fn sizes(field: &MeshField) -> (usize, usize) {
     (field.num_vertices(), field.faces.len())
 }
 
-/// Reconstructs one state from its training `frames` (see the module docs), and measures the
-/// result on its `held_out` views (may be empty) at the end.
+/// Reconstructs one state from its training views (see the module docs), and measures the
+/// result on its held-out views (may be none) at the end.
 pub async fn reconstruct_state(
     ctx: &GpuContext,
     state: State,
-    frames: &[Frame],
-    held_out: &[Frame],
+    views: &StateViews,
     num_parts: usize,
     config: &ReconstructionConfig,
     observer: &mut dyn Observer,
 ) -> GpuResult<StateReconstruction> {
+    let (frames, held_out) = (&views.train[..], &views.held_out[..]);
     let t0 = now_seconds();
+    // Where the dataset measured every part, the optimised vertices would all be replaced at the
+    // remesh: the photometric steps go to the recovery on the measured surface instead.
+    let skip = ReconstructionConfig {
+        fit: PhotometricConfig {
+            iterations: 0,
+            ..config.fit
+        },
+        ..*config
+    };
+    let measured = views.measured.as_ref();
+    let all_measured = config.surface == SurfaceSource::Measured
+        && measured.is_some_and(|m| measures_every_part(m, num_parts));
+    let config = if all_measured { &skip } else { config };
     let mut run = StateRun {
         ctx,
         state,
@@ -130,7 +146,7 @@ pub async fn reconstruct_state(
         fit.seed,
     )?;
     let optimised = optimise(&mut run, &mut trainer, &field, frames.len(), px_per_m).await?;
-    let (remeshed, remesh_stats) = remesh_stage(&mut run, &optimised.field).await?;
+    let (remeshed, remesh_stats) = remesh_stage(&mut run, &optimised.field, measured).await?;
     let recovered = recover(&mut run, &mut trainer, &remeshed).await?;
     let recovery = config.recovery();
     let last = recovery.settings_at(recovery.iterations);
@@ -291,8 +307,9 @@ async fn densify(
 async fn remesh_stage(
     run: &mut StateRun<'_>,
     optimised: &MeshField,
+    measured: Option<&ObservedState>,
 ) -> GpuResult<(MeshField, RemeshStats)> {
-    let (remeshed, stats) = remesh(optimised, run.config);
+    let (remeshed, stats) = remesh(optimised, measured, run.config);
     if remeshed.faces.is_empty() {
         return Err(run.error(format!(
             "remeshing built no faces from {} vertices",
