@@ -307,12 +307,32 @@ pub fn observe_dataset(
 }
 
 impl PartCloud {
+    /// This cloud and `other` of the same part in the same frame, averaged together in voxels of
+    /// the part's edge (the two sides of a thin part kept apart): where both saw a place it comes
+    /// out once.
+    pub fn merged(&self, other: &PartCloud) -> PartCloud {
+        let joined = PartCloud {
+            points: [&self.points[..], &other.points].concat(),
+            normals: [&self.normals[..], &other.normals].concat(),
+            colors: [&self.colors[..], &other.colors].concat(),
+            pixels: self.pixels + other.pixels,
+            labelled: self.labelled + other.labelled,
+        };
+        joined.voxelised_under(joined.points.len(), 1.0)
+    }
+
     /// The cloud averaged again in coarser voxels (the two sides of a thin part kept apart) until
     /// it has at most `max_points` points; itself if it already has.
     pub fn coarsened(&self, max_points: usize) -> PartCloud {
         if self.points.len() <= max_points {
             return self.clone();
         }
+        self.voxelised_under(max_points, 1.25)
+    }
+
+    /// Averaged in voxels of the part's default edge times `scale`, the edge growing by a quarter
+    /// until at most `max_points` points come out.
+    fn voxelised_under(&self, max_points: usize, scale: f32) -> PartCloud {
         let samples: Vec<Sample> = (0..self.points.len())
             .map(|i| Sample {
                 part: 0,
@@ -323,10 +343,10 @@ impl PartCloud {
             .collect();
         let refs: Vec<&Sample> = samples.iter().collect();
         let defaults = CloudOptions::default();
-        let mut edge =
-            (extent(self.points.iter().copied()) / defaults.voxels_across).max(defaults.min_voxel);
+        let mut edge = scale
+            * (extent(self.points.iter().copied()) / defaults.voxels_across)
+                .max(defaults.min_voxel);
         loop {
-            edge *= 1.25;
             let cloud = voxelise(&refs, edge);
             if cloud.points.len() <= max_points.max(1) {
                 return PartCloud {
@@ -335,6 +355,7 @@ impl PartCloud {
                     ..cloud
                 };
             }
+            edge *= 1.25;
         }
     }
 }

@@ -21,8 +21,12 @@ pub struct PartQuality {
     pub components: usize,
     /// Connected pieces of the ground-truth part mesh after welding coincident vertices.
     pub gt_components: Option<usize>,
+    /// Distinct edges, and those used by one face / by three or more.
+    pub edges: usize,
     pub boundary_edges: usize,
     pub non_manifold_edges: usize,
+    /// Boundary edges of the welded ground-truth part mesh (0: a closed surface).
+    pub gt_boundary_edges: Option<usize>,
     /// Against the ground-truth part mesh, when there is one and both meshes have area.
     pub chamfer: Option<ChamferDistance>,
     /// Why there is no Chamfer distance, when there is none.
@@ -68,10 +72,9 @@ pub(crate) fn part_quality(
     options: &ChamferOptions,
 ) -> PartQuality {
     let edges = edge_counts(&mesh.triangles);
-    let gt_components = gt.filter(|g| !g.triangles.is_empty()).map(|g| {
-        let (_, faces, _) = weld(&g.positions, &g.triangles, 1e-5);
-        face_components(&faces).1
-    });
+    let gt_topology = gt.and_then(gt_topology);
+    let gt_components = gt_topology.map(|(pieces, _)| pieces);
+    let gt_boundary_edges = gt_topology.map(|(_, boundary)| boundary);
     let (chamfer, chamfer_missing) = match gt {
         None => (None, Some("no ground-truth mesh".to_string())),
         Some(g) => match chamfer_meshes(mesh, g, options) {
@@ -85,11 +88,34 @@ pub(crate) fn part_quality(
         faces: mesh.triangles.len(),
         components: face_components(&mesh.triangles).1,
         gt_components,
+        edges: edges.edges,
         boundary_edges: edges.boundary,
         non_manifold_edges: edges.non_manifold,
+        gt_boundary_edges,
         chamfer,
         chamfer_missing,
     }
+}
+
+/// Connected pieces and boundary edges of a ground-truth mesh, its coincident vertices welded;
+/// `None` for an empty one.
+fn gt_topology(gt: &TriMesh) -> Option<(usize, usize)> {
+    if gt.triangles.is_empty() {
+        return None;
+    }
+    let (_, faces, _) = weld(&gt.positions, &gt.triangles, 1e-5);
+    Some((face_components(&faces).1, edge_counts(&faces).boundary))
+}
+
+/// The ground-truth mesh of part `k` (0 = static base) in `gt`.
+fn gt_part(gt: Option<&GtMeshes>, k: usize) -> Option<&TriMesh> {
+    gt.and_then(|g| {
+        if k == 0 {
+            Some(&g.static_part)
+        } else {
+            g.movable.get(k - 1)
+        }
+    })
 }
 
 /// Quality of one state's reconstruction.
@@ -98,15 +124,6 @@ pub(crate) fn state_quality(
     gt: Option<&GtMeshes>,
     options: &ChamferOptions,
 ) -> StateQuality {
-    let gt_part = |k: usize| {
-        gt.and_then(|g| {
-            if k == 0 {
-                Some(&g.static_part)
-            } else {
-                g.movable.get(k - 1)
-            }
-        })
-    };
     StateQuality {
         state: state.state,
         cross_part_faces: crate::mesh::topology::cross_part_faces(&state.field.faces, &state.parts),
@@ -126,7 +143,7 @@ pub(crate) fn state_quality(
             .part_meshes
             .iter()
             .enumerate()
-            .map(|(k, m)| part_quality(k, m, gt_part(k), options))
+            .map(|(k, m)| part_quality(k, m, gt_part(gt, k), options))
             .collect(),
     }
 }
@@ -195,4 +212,73 @@ pub fn reconstruction_failures(
         }
     }
     failures
+}
+
+/// The mesh facts of a reconstruction summed over both states' parts: what issue 27 asks of a
+/// simulation-ready twin.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct MeshSummary {
+    /// Part meshes (both states).
+    pub parts: usize,
+    pub edges: usize,
+    pub boundary_edges: usize,
+    /// The same over the parts whose ground truth is a closed surface.
+    pub closed_parts: usize,
+    pub closed_part_edges: usize,
+    pub closed_part_boundary_edges: usize,
+    pub non_manifold_edges: usize,
+    pub cross_part_faces: usize,
+    /// Parts in more connected pieces than their ground truth.
+    pub split_parts: usize,
+    /// Short holes closed after remeshing.
+    pub holes_closed: usize,
+}
+
+impl MeshSummary {
+    /// Boundary edges as a fraction of all edges of the parts whose ground truth is closed.
+    pub fn closed_boundary_fraction(&self) -> f64 {
+        self.closed_part_boundary_edges as f64 / self.closed_part_edges.max(1) as f64
+    }
+
+    /// The sum of `self` and `other`.
+    pub fn plus(&self, other: &MeshSummary) -> MeshSummary {
+        MeshSummary {
+            parts: self.parts + other.parts,
+            edges: self.edges + other.edges,
+            boundary_edges: self.boundary_edges + other.boundary_edges,
+            closed_parts: self.closed_parts + other.closed_parts,
+            closed_part_edges: self.closed_part_edges + other.closed_part_edges,
+            closed_part_boundary_edges: self.closed_part_boundary_edges
+                + other.closed_part_boundary_edges,
+            non_manifold_edges: self.non_manifold_edges + other.non_manifold_edges,
+            cross_part_faces: self.cross_part_faces + other.cross_part_faces,
+            split_parts: self.split_parts + other.split_parts,
+            holes_closed: self.holes_closed + other.holes_closed,
+        }
+    }
+}
+
+/// [`MeshSummary`] of `reconstruction` against the ground-truth part meshes per state (start,
+/// end) when known (no Chamfer distances: cheap enough for every benchmark object).
+pub fn mesh_summary(reconstruction: &Reconstruction, gt: &[Option<GtMeshes>; 2]) -> MeshSummary {
+    let mut sum = MeshSummary::default();
+    for s in &reconstruction.states {
+        sum.cross_part_faces += crate::mesh::topology::cross_part_faces(&s.field.faces, &s.parts);
+        sum.holes_closed += s.remesh.holes.closed;
+        for (k, mesh) in s.part_meshes.iter().enumerate() {
+            let edges = edge_counts(&mesh.triangles);
+            let gt = gt_part(gt[s.state.index()].as_ref(), k).and_then(gt_topology);
+            let closed = gt.is_some_and(|(_, boundary)| boundary == 0);
+            sum.parts += 1;
+            sum.edges += edges.edges;
+            sum.boundary_edges += edges.boundary;
+            sum.closed_parts += closed as usize;
+            sum.closed_part_edges += if closed { edges.edges } else { 0 };
+            sum.closed_part_boundary_edges += if closed { edges.boundary } else { 0 };
+            sum.non_manifold_edges += edges.non_manifold;
+            let pieces = face_components(&mesh.triangles).1;
+            sum.split_parts += gt.is_some_and(|(g, _)| pieces > g) as usize;
+        }
+    }
+    sum
 }

@@ -33,7 +33,10 @@ pub use joints::{
     JointFault, JointMatching, JointPairMetrics, Solver, axis_angle_deg, axis_line_distance,
     axis_pos, match_joints, match_joints_using, motion_error,
 };
-pub use mesh_quality::{PartQuality, ReconstructionReport, StateQuality, reconstruction_report};
+pub use mesh_quality::{
+    MeshSummary, PartQuality, ReconstructionReport, StateQuality, mesh_summary,
+    reconstruction_report,
+};
 pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_fit, evaluate_object};
 pub use tables::{BenchmarkTable, ColumnSummary};
 

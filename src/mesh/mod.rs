@@ -1,14 +1,16 @@
 //! Mesh operations of the reconstruction phase, on the CPU copy of the mesh field: part-aware
 //! restricted Delaunay remeshing ([`restricted_delaunay`], [`part_aware_remesh`]) and the topology
-//! edits around it (densification splits, pruning, hardening, connectivity counts), and the
-//! closest-point queries the articulation phase matches vertices with ([`closest`]), and the k-d
-//! tree nearest-neighbour search over point sets ([`spatial`]).
+//! edits around it (densification splits, pruning, hardening, connectivity counts, closing short
+//! holes), the closest-point queries the articulation phase matches vertices with ([`closest`]),
+//! and the k-d tree nearest-neighbour search over point sets ([`spatial`]).
 
 pub mod closest;
+mod holes;
 mod restricted_delaunay;
 pub mod spatial;
 pub mod topology;
 
+pub use holes::{HoleStats, close_short_holes};
 pub use restricted_delaunay::{RemeshOptions, part_aware_remesh, restricted_delaunay};
 pub use topology::{
     EdgeCounts, PartSubmesh, edge_counts, face_components, harden_parts, part_meshes,

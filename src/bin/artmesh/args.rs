@@ -110,6 +110,10 @@ pub struct BudgetArgs {
     /// [default: measured for fast, optimised for tiny and paper].
     #[arg(long, value_parser = ["measured", "optimised"])]
     surface: Option<String>,
+    /// After remeshing, close each part's holes bounded by at most this many edges (0: none)
+    /// [default: 48].
+    #[arg(long)]
+    close_holes: Option<usize>,
 }
 
 impl BudgetArgs {
@@ -131,6 +135,9 @@ impl BudgetArgs {
             Some("measured") => config.reconstruction.surface = SurfaceSource::Measured,
             Some(_) => config.reconstruction.surface = SurfaceSource::Optimised,
             None => {}
+        }
+        if let Some(n) = self.close_holes {
+            config.reconstruction.close_holes = n;
         }
         Ok(config)
     }

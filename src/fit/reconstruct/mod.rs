@@ -62,7 +62,10 @@ pub fn training_views(
 pub struct StateViews {
     pub train: Vec<Frame>,
     pub held_out: Vec<Frame>,
+    /// This state's measured clouds, as the measured joints read them.
     pub measured: Option<ObservedState>,
+    /// The clouds its mesh is built over: `measured` with the static base seen in both states.
+    pub surface: Option<ObservedState>,
 }
 
 /// The held-out (test) views of `state`, all of them, downsampled as the training views are;
@@ -105,6 +108,10 @@ pub fn state_views(dataset: &Dataset, config: &ReconstructionConfig) -> GpuResul
     let measured = (config.surface == SurfaceSource::Measured)
         .then(|| observe_dataset(dataset, Split::Train, &surface_clouds()))
         .flatten();
+    let mut surface = measured
+        .as_ref()
+        .map(|[s, e]| [Some(with_both_bases(s, e)), Some(with_both_bases(e, s))])
+        .unwrap_or_default();
     let mut measured = measured
         .map(|[s, e]| [Some(s), Some(e)])
         .unwrap_or_default();
@@ -114,9 +121,20 @@ pub fn state_views(dataset: &Dataset, config: &ReconstructionConfig) -> GpuResul
                 .map_err(|e| GpuError::InvalidInput(e.to_string()))?,
             held_out: test_views(dataset, state, config),
             measured: measured[state.index()].take(),
+            surface: surface[state.index()].take(),
         })
     };
     Ok([views(State::Start)?, views(State::End)?])
+}
+
+/// `own` with its static base (part 0) measured in both states: the base does not move, and
+/// what one state hides of it (a cabinet's inside behind closed doors) the other may show.
+fn with_both_bases(own: &ObservedState, other: &ObservedState) -> ObservedState {
+    let mut out = own.clone();
+    if let (Some(base), Some(seen)) = (out.parts.first_mut(), other.parts.first()) {
+        *base = base.merged(seen);
+    }
+    out
 }
 
 /// Reconstructs both states of `dataset`: natively at once ([`both`]), in the browser in turn.

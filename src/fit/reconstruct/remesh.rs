@@ -1,6 +1,6 @@
 //! Hardening and part-aware remeshing (paper §3.1): part labels hardened by argmax, the
 //! optimised faces dropped, and connectivity rebuilt by restricted Delaunay per part (or over
-//! all vertices, the ablation), small floating pieces removed.
+//! all vertices, the ablation), small floating pieces removed, short holes closed.
 
 use glam::Vec3;
 
@@ -11,7 +11,7 @@ use crate::mesh::topology::{
     compact, cross_part_faces, drop_small_components, face_part, median_edge, thin_vertices,
     vertex_normals,
 };
-use crate::mesh::{harden_parts, part_aware_remesh, restricted_delaunay};
+use crate::mesh::{close_short_holes, harden_parts, part_aware_remesh, restricted_delaunay};
 use crate::raster::{MeshField, SH_FLOATS};
 
 /// Fewer measured points than this and a part keeps its optimised vertices.
@@ -80,12 +80,20 @@ pub(super) fn remesh(
         }
     }
     stats.floater_faces = keep.iter().filter(|k| !**k).count();
-    let faces: Vec<[u32; 3]> = faces
+    let mut faces: Vec<[u32; 3]> = faces
         .iter()
         .zip(&keep)
         .filter(|(_, k)| **k)
         .map(|(f, _)| *f)
         .collect();
+    close_holes(
+        &used.positions,
+        &used_parts,
+        field.num_parts,
+        &mut faces,
+        config,
+        &mut stats,
+    );
     let (mut out, _) = compact(&used, faces);
     stats.unused_vertices = field.num_vertices().saturating_sub(out.num_vertices());
     // Hardened logits: the label strongly, so renders of part logits show the labels.
@@ -97,6 +105,31 @@ pub(super) fn remesh(
         logits[k as usize] = 10.0;
     }
     (out, stats)
+}
+
+/// `faces` with each part's short holes closed (`config.close_holes`), counted in `stats`.
+fn close_holes(
+    positions: &[Vec3],
+    parts: &[u32],
+    num_parts: usize,
+    faces: &mut Vec<[u32; 3]>,
+    config: &ReconstructionConfig,
+    stats: &mut RemeshStats,
+) {
+    let mut added = Vec::new();
+    for k in 0..num_parts as u32 {
+        let own: Vec<[u32; 3]> = faces
+            .iter()
+            .filter(|f| face_part(f, parts) == k)
+            .copied()
+            .collect();
+        let (fill, holes) = close_short_holes(positions, &own, config.close_holes);
+        stats.holes.loops += holes.loops;
+        stats.holes.closed += holes.closed;
+        stats.holes.faces += holes.faces;
+        added.extend(fill);
+    }
+    faces.extend(added);
 }
 
 /// Whether `measured` has enough points of each of `num_parts` parts to replace them all.
@@ -167,6 +200,7 @@ mod tests {
 
     use super::*;
     use crate::articulation::observed::PartCloud;
+    use crate::mesh::edge_counts;
 
     /// A flat square of `n`² points at height `z`, normals up.
     fn square(n: usize, z: f32) -> PartCloud {
@@ -233,5 +267,46 @@ mod tests {
         let (remeshed, stats) = remesh(&field, Some(&measured), &config);
         assert_eq!(stats.cross_part_faces, 0);
         assert!(remeshed.faces.len() > 100, "{} faces", remeshed.faces.len());
+    }
+
+    #[test]
+    fn a_short_hole_in_a_measured_part_is_closed_and_the_rim_left_open() {
+        // A measured sheet with a 2x2 gap of points in its middle.
+        let mut sheet = square(16, 0.0);
+        let gap = |i: usize| (7..9).contains(&(i % 16)) && (7..9).contains(&(i / 16));
+        let keep: Vec<usize> = (0..sheet.points.len()).filter(|&i| !gap(i)).collect();
+        for list in [&mut sheet.points, &mut sheet.normals, &mut sheet.colors] {
+            *list = keep.iter().map(|&i| list[i]).collect();
+        }
+        let field = MeshField::new(vec![Vec3::ZERO; 3], Vec::new(), 1, 0.0);
+        let measured = ObservedState {
+            parts: vec![sheet],
+            views_with_depth: 1,
+            views: 1,
+            stride: 1,
+        };
+        let config = |close_holes| ReconstructionConfig {
+            surface: SurfaceSource::Measured,
+            close_holes,
+            ..ReconstructionConfig::preset(crate::fit::preset::Preset::Tiny)
+        };
+        let (open, open_stats) = remesh(&field, Some(&measured), &config(0));
+        let (closed, stats) = remesh(&field, Some(&measured), &config(12));
+        let (open_edges, edges) = (edge_counts(&open.faces), edge_counts(&closed.faces));
+        assert_eq!(open_stats.holes.closed, 0);
+        // Two loops: the gap's, closed, and the sheet's rim (longer than 12 edges), left open.
+        assert_eq!(
+            (stats.holes.loops, stats.holes.closed),
+            (2, 1),
+            "{:?}",
+            stats.holes
+        );
+        assert!(
+            edges.boundary < open_edges.boundary,
+            "{edges:?} vs {open_edges:?}"
+        );
+        assert!(edges.boundary > 12, "{edges:?}");
+        assert_eq!(edges.non_manifold, 0);
+        assert_eq!(closed.faces.len(), open.faces.len() + stats.holes.faces);
     }
 }

@@ -84,6 +84,8 @@ pub struct RemeshStats {
     pub floater_faces: usize,
     /// Vertices dropped: thinned out before remeshing, or used by no rebuilt face.
     pub unused_vertices: usize,
+    /// Boundary loops of the rebuilt parts and those closed (`close_holes`).
+    pub holes: crate::mesh::HoleStats,
 }
 
 /// One state's reconstruction.

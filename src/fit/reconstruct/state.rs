@@ -113,7 +113,7 @@ pub async fn reconstruct_state(
         },
         ..*config
     };
-    let measured = views.measured.as_ref();
+    let measured = views.surface.as_ref();
     let all_measured = config.surface == SurfaceSource::Measured
         && measured.is_some_and(|m| measures_every_part(m, num_parts));
     let config = if all_measured { &skip } else { config };

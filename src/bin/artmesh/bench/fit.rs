@@ -6,7 +6,9 @@ use std::time::Instant;
 
 use artmesh::data::Dataset;
 use artmesh::data::degrade::DepthDegradation;
-use artmesh::eval::{BenchmarkTable, ColumnSummary, EvalOptions, ObjectMetrics};
+use artmesh::eval::{
+    BenchmarkTable, ColumnSummary, EvalOptions, MeshSummary, ObjectMetrics, mesh_summary,
+};
 use artmesh::export::JointRecord;
 use artmesh::fit::articulate::{Ablation, ArticulationConfig, GeometryUse, articulate};
 use artmesh::fit::object::{FitConfig, ObjectFit};
@@ -124,6 +126,14 @@ fn log_object(o: &FitObject) {
         f(m.cd_m.map(|c| c.cd_peer)),
         f(m.type_accuracy)
     );
+    eprintln!(
+        "bench fit:   meshes: {:.1} % boundary edges on closed parts, {} non-manifold edges, {} cross-part faces, {} split parts, {} holes closed",
+        100.0 * o.mesh.closed_boundary_fraction(),
+        o.mesh.non_manifold_edges,
+        o.mesh.cross_part_faces,
+        o.mesh.split_parts,
+        o.mesh.holes_closed
+    );
     for w in &o.warnings {
         eprintln!("bench fit:   warning: {w}");
     }
@@ -146,6 +156,8 @@ pub struct FitObject {
     /// The same over each state's held-out (test) views.
     pub psnr_test: [Option<f64>; 2],
     pub metrics: ObjectMetrics,
+    /// Both states' part meshes: boundary, non-manifold and cross-part counts, split parts.
+    pub mesh: MeshSummary,
     pub joints: Vec<JointRecord>,
     pub warnings: Vec<String>,
 }
@@ -184,11 +196,33 @@ impl FitBench {
             self.by_part_count.to_markdown(),
             self.by_category.to_markdown()
         );
+        out.push_str(&meshes_markdown(&self.objects));
         if let Some(t) = &self.ablation {
             out.push_str(&format!("\n### Ablations\n\n{}", t.to_markdown()));
         }
         out
     }
+}
+
+/// The mesh facts summed over `objects`, as a Markdown table.
+fn meshes_markdown(objects: &[FitObject]) -> String {
+    let m = objects
+        .iter()
+        .fold(MeshSummary::default(), |sum, o| sum.plus(&o.mesh));
+    format!(
+        "\n### Meshes (both states, all objects)\n\n\
+         | Part meshes | Boundary edges | On closed parts | Non-manifold edges | Cross-part faces | Split parts | Holes closed |\n\
+         |---|---|---|---|---|---|---|\n\
+         | {} | {:.1} % | {:.1} % ({} parts) | {} | {} | {} | {} |\n",
+        m.parts,
+        100.0 * m.boundary_edges as f64 / m.edges.max(1) as f64,
+        100.0 * m.closed_boundary_fraction(),
+        m.closed_parts,
+        m.non_manifold_edges,
+        m.cross_part_faces,
+        m.split_parts,
+        m.holes_closed
+    )
 }
 
 /// The ablation variants of the articulation phase, by table label.
@@ -318,6 +352,7 @@ fn fit_one(
         }),
         psnr_test: [0, 1].map(|i| fit.reconstruction.states.get(i).and_then(|s| s.psnr_test)),
         metrics: score(&fit, dataset, object)?,
+        mesh: mesh_summary(&fit.reconstruction, &dataset.gt_meshes),
         joints: artmesh::export::joint_records(&fit),
         warnings: fit.articulation.warnings.clone(),
     };
