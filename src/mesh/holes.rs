@@ -9,10 +9,14 @@ use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
+/// The longest loop [`close_short_holes`] fills: its triangulation takes O(n²) memory and O(n³)
+/// time in the loop's length.
+pub const MAX_HOLE_EDGES: usize = 256;
+
 /// What [`close_short_holes`] did.
 #[derive(Debug, Clone, Copy, Default, PartialEq, Eq, serde::Serialize)]
 pub struct HoleStats {
-    /// Boundary loops found (simple loops only: a vertex on two loops makes both unsafe).
+    /// Simple boundary loops found.
     pub loops: usize,
     /// Loops closed.
     pub closed: usize,
@@ -21,7 +25,7 @@ pub struct HoleStats {
 }
 
 /// Faces that close every hole of `faces` (one part's) bounded by a simple loop of at most
-/// `max_edges` edges (3 or more), and what was done.
+/// `max_edges` edges (3 or more; at most [`MAX_HOLE_EDGES`]), and what was done.
 ///
 /// The boundary edges are split into simple loops: closed walks along unused boundary edges, cut
 /// where a walk comes back to a vertex it passed (a vertex where two holes touch, or a hole and a
@@ -33,6 +37,7 @@ pub fn close_short_holes(
     max_edges: usize,
 ) -> (Vec<[u32; 3]>, HoleStats) {
     let mut stats = HoleStats::default();
+    let max_edges = max_edges.min(MAX_HOLE_EDGES);
     if max_edges < 3 {
         return (Vec::new(), stats);
     }

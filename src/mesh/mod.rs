@@ -10,7 +10,7 @@ mod restricted_delaunay;
 pub mod spatial;
 pub mod topology;
 
-pub use holes::{HoleStats, close_short_holes};
+pub use holes::{HoleStats, MAX_HOLE_EDGES, close_short_holes};
 pub use restricted_delaunay::{RemeshOptions, part_aware_remesh, restricted_delaunay};
 pub use topology::{
     EdgeCounts, PartSubmesh, edge_counts, face_components, harden_parts, part_meshes,

@@ -171,6 +171,25 @@ fn info_and_fit_name_what_a_fit_would_refuse() {
 }
 
 #[test]
+fn fit_refuses_a_hole_size_it_cannot_fill_in_bounded_memory() {
+    let tmp = TempDir::new("outputs-holes");
+    let out = tmp.join("fit");
+    // Refused before the dataset is read: the folder need not exist.
+    refused(
+        &[
+            "fit",
+            &tmp.join("none"),
+            "--close-holes",
+            "100000",
+            "--out",
+            &out,
+        ],
+        "--close-holes: expected at most 256 edges (0: none), found 100000",
+    );
+    assert!(!Path::new(&out).exists());
+}
+
+#[test]
 fn render_refuses_links_and_full_folders_and_leaves_nothing_when_it_fails() {
     let tmp = TempDir::new("outputs-render");
     let object = tmp.join("object");

@@ -5,6 +5,7 @@ use artmesh::fit::object::FitConfig;
 use artmesh::fit::preset::{BudgetOverrides, Preset};
 use artmesh::fit::reconstruct::{ReconstructionConfig, RemeshMode, SurfaceSource};
 use artmesh::gpu::GpuContext;
+use artmesh::mesh::MAX_HOLE_EDGES;
 use artmesh::render::RenderSpec;
 
 /// Which suite objects a benchmark fits, and how they are captured.
@@ -110,8 +111,8 @@ pub struct BudgetArgs {
     /// [default: measured for fast, optimised for tiny and paper].
     #[arg(long, value_parser = ["measured", "optimised"])]
     surface: Option<String>,
-    /// After remeshing, close each part's holes bounded by at most this many edges (0: none)
-    /// [default: 48].
+    /// After remeshing, close each part's holes bounded by at most this many edges (0: none,
+    /// at most 256) [default: 48].
     #[arg(long)]
     close_holes: Option<usize>,
 }
@@ -137,6 +138,11 @@ impl BudgetArgs {
             None => {}
         }
         if let Some(n) = self.close_holes {
+            if n > MAX_HOLE_EDGES {
+                return Err(format!(
+                    "--close-holes: expected at most {MAX_HOLE_EDGES} edges (0: none), found {n}"
+                ));
+            }
             config.reconstruction.close_holes = n;
         }
         Ok(config)
