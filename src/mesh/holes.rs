@@ -205,24 +205,10 @@ mod tests {
     use super::*;
     use crate::mesh::edge_counts;
 
-    /// A unit cube's 12 faces, outward.
+    /// A unit cube's 8 corners and 12 outward faces (its top, z = 1, is faces 2 and 3).
     fn cube() -> (Vec<Vec3>, Vec<[u32; 3]>) {
-        let p = (0..8)
-            .map(|i| Vec3::new((i & 1) as f32, ((i >> 1) & 1) as f32, ((i >> 2) & 1) as f32))
-            .collect();
-        let quads = [
-            [0, 2, 3, 1],
-            [4, 5, 7, 6],
-            [0, 1, 5, 4],
-            [2, 6, 7, 3],
-            [0, 4, 6, 2],
-            [1, 3, 7, 5],
-        ];
-        let faces = quads
-            .iter()
-            .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
-            .collect();
-        (p, faces)
+        let mesh = crate::data::fixture::box_mesh(Vec3::ZERO, Vec3::ONE);
+        (mesh.positions, mesh.triangles)
     }
 
     #[test]

@@ -69,35 +69,39 @@ pub(super) fn remesh(
     };
     stats.faces_built = faces.len();
     stats.cross_part_faces = cross_part_faces(&faces, &used_parts);
-    // Floaters are judged per part, among that part's faces.
+    // Floaters are judged per part, among that part's faces; then the part's short holes are
+    // closed, the new faces after all the kept ones.
     let mut keep = vec![false; faces.len()];
+    let mut fills = Vec::new();
     for k in 0..field.num_parts as u32 {
         let ids: Vec<usize> = (0..faces.len())
             .filter(|&f| face_part(&faces[f], &used_parts) == k)
             .collect();
         let own: Vec<[u32; 3]> = ids.iter().map(|&f| faces[f]).collect();
-        for (&f, kept) in ids
-            .iter()
-            .zip(drop_small_components(&own, config.min_component_fraction))
-        {
+        let kept = drop_small_components(&own, config.min_component_fraction);
+        for (&f, &kept) in ids.iter().zip(&kept) {
             keep[f] = kept;
         }
+        let own: Vec<[u32; 3]> = own
+            .into_iter()
+            .zip(kept)
+            .filter(|(_, k)| *k)
+            .map(|(f, _)| f)
+            .collect();
+        let (fill, holes) = close_short_holes(&used.positions, &own, config.close_holes);
+        stats.holes.loops += holes.loops;
+        stats.holes.closed += holes.closed;
+        stats.holes.faces += holes.faces;
+        fills.extend(fill);
     }
     stats.floater_faces = keep.iter().filter(|k| !**k).count();
-    let mut faces: Vec<[u32; 3]> = faces
+    let faces: Vec<[u32; 3]> = faces
         .iter()
         .zip(&keep)
         .filter(|(_, k)| **k)
         .map(|(f, _)| *f)
+        .chain(fills)
         .collect();
-    close_holes(
-        &used.positions,
-        &used_parts,
-        field.num_parts,
-        &mut faces,
-        config,
-        &mut stats,
-    );
     let (mut out, _) = compact(&used, faces);
     stats.unused_vertices = field.num_vertices().saturating_sub(out.num_vertices());
     // Hardened logits: the label strongly, so renders of part logits show the labels.
@@ -109,31 +113,6 @@ pub(super) fn remesh(
         logits[k as usize] = 10.0;
     }
     (out, stats)
-}
-
-/// `faces` with each part's short holes closed (`config.close_holes`), counted in `stats`.
-fn close_holes(
-    positions: &[Vec3],
-    parts: &[u32],
-    num_parts: usize,
-    faces: &mut Vec<[u32; 3]>,
-    config: &ReconstructionConfig,
-    stats: &mut RemeshStats,
-) {
-    let mut added = Vec::new();
-    for k in 0..num_parts as u32 {
-        let own: Vec<[u32; 3]> = faces
-            .iter()
-            .filter(|f| face_part(f, parts) == k)
-            .copied()
-            .collect();
-        let (fill, holes) = close_short_holes(positions, &own, config.close_holes);
-        stats.holes.loops += holes.loops;
-        stats.holes.closed += holes.closed;
-        stats.holes.faces += holes.faces;
-        added.extend(fill);
-    }
-    faces.extend(added);
 }
 
 /// Whether `measured` has enough points of each of `num_parts` parts to replace them all.
