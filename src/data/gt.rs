@@ -4,7 +4,7 @@
 //! "rotate"|"translate": {"l": start, "r": end}}, ... ]}`, one entry per movable part in part order; PARIS writes
 //! a single object instead of a list. Angles are degrees, translations metres.
 
-use glam::Vec3;
+use glam::{Affine3A, Quat, Vec3};
 use serde_json::{Value, json};
 
 use super::FileSet;
@@ -58,6 +58,28 @@ impl GtJoint {
     /// Unit axis direction.
     pub fn unit_direction(&self) -> Vec3 {
         self.direction.normalize_or_zero()
+    }
+
+    /// Motion from start to end in URDF units: radians for a revolute joint, metres for a
+    /// prismatic one.
+    pub fn urdf_motion(&self) -> f32 {
+        match self.kind {
+            JointKind::Revolute => self.motion().to_radians(),
+            JointKind::Prismatic => self.motion(),
+        }
+    }
+
+    /// Where a part goes when its joint moves by `value` (URDF units) from the start state: a
+    /// rotation about the axis through its origin, or a shift along it.
+    pub fn pose_at(&self, value: f32) -> Affine3A {
+        let d = self.unit_direction();
+        match self.kind {
+            JointKind::Revolute => {
+                let r = Affine3A::from_quat(Quat::from_axis_angle(d, value));
+                Affine3A::from_translation(self.origin) * r * Affine3A::from_translation(-self.origin)
+            }
+            JointKind::Prismatic => Affine3A::from_translation(d * value),
+        }
     }
 }
 

@@ -11,15 +11,17 @@
 //! - Animation `start_to_end`, 2 s: revolute/continuous joints as rotation keyframes at most 30°
 //!   apart (glTF slerps, which would take the short way round past 180°), prismatic ones as two
 //!   translation keyframes. Mimic joints follow through [`ArticulatedObject::apply_mimic`].
-//! - `extras.joint` on a child node: name, type, axis (joint frame), origin (xyz, rpy in the parent
+//! - `extras.joint` on a child node (`super::extras`): name, type, axis (joint frame), origin (xyz, rpy in the parent
 //!   frame), limits and the start/end values, in URDF units (radians, metres).
+//! - `extras.collision` on a link's node: its collision meshes (a twin's convex pieces) in the
+//!   link frame, as the URDF's STLs hold them.
 //!
 //! Checked by the Khronos glTF validator in the tests (`tests/native/export.rs`).
 
 use std::collections::HashMap;
 use std::sync::Arc;
 
-use glam::{Affine3A, EulerRot, Quat, Vec3};
+use glam::{Affine3A, Quat, Vec3};
 use gltf::json::{self, validation::Checked::Valid, validation::USize64};
 
 use crate::data::{DataError, PngPixels, RgbaImage, encode_png};
@@ -59,7 +61,7 @@ pub fn write_glb(
             continue;
         };
         let local = joint.origin * joint.motion(start[j]);
-        let extras = joint_extras(obj, j, start[j], end[j]);
+        let extras = super::extras::joint(obj, j, start[j], end[j]);
         let node = b.link_node(obj, joint.child, local, Some(extras), file)?;
         b.root.nodes[parent.value()]
             .children
@@ -155,37 +157,6 @@ fn keyframes(
     }
 }
 
-/// `extras.joint` of a child node.
-fn joint_extras(obj: &ArticulatedObject, j: usize, start: f32, end: f32) -> serde_json::Value {
-    let joint = &obj.joints[j];
-    let (_, rotation, xyz) = joint.origin.to_scale_rotation_translation();
-    let (yaw, pitch, roll) = rotation.to_euler(EulerRot::ZYX);
-    let rpy = [roll, pitch, yaw].map(|a| a + 0.0); // -0 → 0
-    let kind = match joint.kind {
-        JointKind::Fixed => "fixed",
-        JointKind::Revolute => "revolute",
-        JointKind::Continuous => "continuous",
-        JointKind::Prismatic => "prismatic",
-    };
-    let name = |l: usize| obj.links.get(l).map(|l| l.name.clone());
-    serde_json::json!({
-        "joint": {
-            "name": joint.name,
-            "type": kind,
-            "parent": name(joint.parent),
-            "child": name(joint.child),
-            "axis": joint.axis.to_array(),
-            "origin": { "xyz": xyz.to_array(), "rpy": rpy },
-            "limit": joint.limit.map(|l| serde_json::json!({
-                "lower": l.lower, "upper": l.upper, "effort": l.effort, "velocity": l.velocity,
-            })),
-            "start": start,
-            "end": end,
-            "units": if joint.kind == JointKind::Prismatic { "m" } else { "rad" },
-        }
-    })
-}
-
 /// The JSON document and binary chunk under construction.
 #[derive(Default)]
 struct Builder {
@@ -233,7 +204,7 @@ impl Builder {
             translation: (translation != Vec3::ZERO).then(|| translation.to_array()),
             rotation: (rotation != Quat::IDENTITY)
                 .then(|| json::scene::UnitQuaternion(rotation.to_array())),
-            extras: extras.and_then(raw),
+            extras: super::extras::with_collision(extras, obj, link).and_then(raw),
             ..Default::default()
         }))
     }

@@ -14,6 +14,8 @@
 //! Like the rest of the core, bytes in and bytes out: the browser app downloads what these return.
 
 pub mod archive;
+pub mod collision;
+pub(crate) mod extras;
 pub mod finite;
 pub mod folder;
 pub mod glb;
@@ -230,7 +232,7 @@ mod tests {
             GLB_FILE,
             ZIP_FILE,
             "urdf/meshes/part_1.obj",
-            "urdf/meshes/part_2_collision.stl",
+            "urdf/meshes/part_2_collision_0.stl",
         ] {
             assert!(folder.contains_key(f), "{f}: {:?}", folder.keys());
         }

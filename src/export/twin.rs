@@ -12,8 +12,9 @@
 
 use std::sync::Arc;
 
-use glam::{Affine3A, Quat, Vec3};
+use glam::{Affine3A, Vec3};
 
+use super::collision::ConvexPiece;
 use crate::data::{GtJoint, GtMeshes, JointKind as GtKind, State, TriMesh};
 use crate::fit::object::ObjectFit;
 use crate::object::{
@@ -113,18 +114,32 @@ impl Twin {
 
     /// Joint values at the end state (radians / metres), one per joint of [`Twin::object`].
     pub fn end_configuration(&self) -> Vec<f32> {
-        self.joints.iter().map(urdf_motion).collect()
+        self.joints.iter().map(GtJoint::urdf_motion).collect()
     }
 
-    /// The twin as an articulated object (see the module docs for its layout).
+    /// The twin as an articulated object (see the module docs for its layout), each link colliding
+    /// as convex pieces cleared along the joints ([`super::collision`]): what the exports write.
     pub fn object(&self) -> ArticulatedObject {
-        let mut links = vec![link(BASE_LINK.into(), self.parts.first(), Vec3::ZERO)];
+        let meshes: Vec<&TriMesh> = self.parts.iter().map(|p| &p.mesh).collect();
+        let pieces = super::collision::part_collisions(&meshes, &self.joints, &Default::default());
+        self.object_with(Some(&pieces))
+    }
+
+    /// The twin as an articulated object with visuals only (no collision shapes): for viewers,
+    /// which do not need the convex decomposition's time.
+    pub fn visual_object(&self) -> ArticulatedObject {
+        self.object_with(None)
+    }
+
+    fn object_with(&self, collisions: Option<&[Vec<ConvexPiece>]>) -> ArticulatedObject {
+        let pieces = |k: usize| collisions.and_then(|c| c.get(k)).map_or(&[][..], |c| c.as_slice());
+        let mut links = vec![link(BASE_LINK.into(), self.parts.first(), Vec3::ZERO, pieces(0))];
         let mut joints = Vec::new();
         for (i, joint) in self.joints.iter().enumerate() {
             let k = i + 1;
             let origin = joint.origin;
-            links.push(link(part_link(k), self.parts.get(k), origin));
-            let motion = urdf_motion(joint);
+            links.push(link(part_link(k), self.parts.get(k), origin, pieces(k)));
+            let motion = joint.urdf_motion();
             joints.push(Joint {
                 name: part_joint(k),
                 // A joint that did not move has an empty range, which MuJoCo reads as unlimited.
@@ -167,17 +182,9 @@ pub fn moved_link_frames(twin: &Twin, motions: &[Affine3A]) -> Vec<Affine3A> {
         .collect()
 }
 
-/// A joint's motion in URDF units: radians for revolute joints, metres for prismatic ones.
-fn urdf_motion(joint: &GtJoint) -> f32 {
-    match joint.kind {
-        GtKind::Revolute => joint.motion().to_radians(),
-        GtKind::Prismatic => joint.motion(),
-    }
-}
-
-/// A link whose frame sits at `origin` (world orientation) with `part`'s mesh as visual and collision.
-fn link(name: String, part: Option<&TwinPart>, origin: Vec3) -> Link {
-    let mesh = part.map(|p| render_mesh(p, origin));
+/// A link whose frame sits at `origin` (world orientation) with `part`'s mesh as visual and
+/// `pieces` (world frame) as collisions.
+fn link(name: String, part: Option<&TwinPart>, origin: Vec3, pieces: &[ConvexPiece]) -> Link {
     let geometry = |file: String, m: RenderMesh| Visual {
         name: None,
         origin: Affine3A::IDENTITY,
@@ -188,13 +195,27 @@ fn link(name: String, part: Option<&TwinPart>, origin: Vec3) -> Link {
         },
         material: None,
     };
-    let (visuals, collisions) = match mesh {
-        Some(m) if !m.indices.is_empty() => (
-            vec![geometry(format!("meshes/{name}.obj"), m.clone())],
-            vec![geometry(format!("meshes/{name}_collision.stl"), m)],
-        ),
-        _ => (Vec::new(), Vec::new()),
+    let visuals = match part.map(|p| render_mesh(p, origin)) {
+        Some(m) if !m.indices.is_empty() => vec![geometry(format!("meshes/{name}.obj"), m)],
+        _ => Vec::new(),
     };
+    let collisions = pieces
+        .iter()
+        .enumerate()
+        .map(|(i, piece)| {
+            let part = TwinPart {
+                mesh: TriMesh {
+                    positions: piece.positions.clone(),
+                    triangles: piece.triangles.clone(),
+                },
+                colors: None,
+            };
+            geometry(
+                format!("meshes/{name}_collision_{i}.stl"),
+                render_mesh(&part, origin),
+            )
+        })
+        .collect();
     Link {
         name,
         visuals,
@@ -243,12 +264,5 @@ pub(crate) fn srgb_to_linear(v: f32) -> f32 {
 /// The start → end transform a joint implies: a revolute joint's rotation by its motion about its
 /// axis through its origin, or a prismatic joint's shift by its motion along its axis.
 pub fn joint_transform(joint: &GtJoint) -> Affine3A {
-    let d = joint.unit_direction();
-    match joint.kind {
-        GtKind::Revolute => {
-            let r = Affine3A::from_quat(Quat::from_axis_angle(d, joint.motion().to_radians()));
-            Affine3A::from_translation(joint.origin) * r * Affine3A::from_translation(-joint.origin)
-        }
-        GtKind::Prismatic => Affine3A::from_translation(d * joint.motion()),
-    }
+    joint.pose_at(joint.urdf_motion())
 }

@@ -4,7 +4,8 @@
 //!   MTL and PNG base-colour textures beside it, so textures survive (URDF primitives cannot carry UVs).
 //!   Vertex colours are written as `v x y z r g b` (read by MeshLab, Open3D, tinyobjloader) and their
 //!   mean becomes the MTL colour for viewers that ignore them.
-//! - Primitive collisions stay primitives; mesh collisions become one binary STL per link.
+//! - Primitive collisions stay primitives; each mesh collision element becomes a binary STL (a
+//!   twin's are its convex pieces, `super::collision`).
 //! - Every link with geometry gets an `<inertial>` from its collision (else visual) meshes at
 //!   [`DENSITY`]: a solid when they are closed, else a 5 mm shell (see [`super::inertia`]), so physics
 //!   engines treat movable links as bodies rather than as massless, static ones.
@@ -60,15 +61,24 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
                 "    <visual>\n      <geometry><mesh filename=\"{obj_path}\"/></geometry>\n    </visual>"
             );
         }
-        let mut collision_meshes = Vec::new();
-        for c in &link.collisions {
-            match &c.geometry {
-                Geometry::Mesh { .. } => collision_meshes.extend(c.link_frame_meshes()),
-                primitive => xml.push_str(&primitive_collision_xml(&c.origin, primitive)),
+        let mesh_collisions: Vec<Vec<RenderMesh>> = link
+            .collisions
+            .iter()
+            .filter_map(|c| match &c.geometry {
+                Geometry::Mesh { .. } => Some(c.link_frame_meshes()),
+                primitive => {
+                    xml.push_str(&primitive_collision_xml(&c.origin, primitive));
+                    None
+                }
+            })
+            .collect();
+        // One STL per mesh collision element: a simulator collides with each one's convex hull.
+        let single = mesh_collisions.len() == 1;
+        for (i, meshes) in mesh_collisions.iter().enumerate() {
+            let (positions, triangles) = merged(meshes);
+            if triangles.is_empty() {
+                continue;
             }
-        }
-        if !collision_meshes.is_empty() {
-            let (positions, triangles) = merged(&collision_meshes);
             match flat_bounds(&positions, &triangles) {
                 // MuJoCo cannot take the convex hull of a flat (or tiny) mesh: a thin box instead.
                 Some((lo, hi)) => {
@@ -80,7 +90,11 @@ pub fn write_urdf(obj: &ArticulatedObject, urdf_name: &str) -> Result<FileSet, D
                     ));
                 }
                 None => {
-                    let path = format!("meshes/{stem}_collision.stl");
+                    let path = if single {
+                        format!("meshes/{stem}_collision.stl")
+                    } else {
+                        format!("meshes/{stem}_collision_{i}.stl")
+                    };
                     files.insert(format!("{folder}{path}"), stl(&positions, &triangles));
                     let _ = writeln!(
                         xml,
@@ -213,7 +227,7 @@ fn inertial_xml(link: &crate::object::Link) -> Option<String> {
 
 /// All triangles of `meshes` as one indexed list (the mass properties weld equal positions, so an
 /// indexed OBJ and a triangle-soup STL of one surface get the same inertial).
-fn merged(meshes: &[RenderMesh]) -> (Vec<glam::Vec3>, Vec<[u32; 3]>) {
+pub(crate) fn merged(meshes: &[RenderMesh]) -> (Vec<glam::Vec3>, Vec<[u32; 3]>) {
     let mut positions = Vec::new();
     let mut triangles = Vec::new();
     for m in meshes {

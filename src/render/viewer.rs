@@ -267,7 +267,7 @@ mod tests {
             },
         ];
         let twin = Twin::from_truth("two", &start, &joints);
-        TwinScene::new(twin.object(), twin.end_configuration())
+        TwinScene::new(twin.visual_object(), twin.end_configuration())
     }
 
     #[test]

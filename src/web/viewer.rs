@@ -42,7 +42,7 @@ impl Viewer {
         let (width, height) = (canvas.width().max(1), canvas.height().max(1));
         let renderer = GtRenderer::new(&ctx, width, height).map_err(js_error)?;
         let twin = &result.0.twin;
-        let scene = TwinScene::new(twin.object(), twin.end_configuration());
+        let scene = TwinScene::new(twin.visual_object(), twin.end_configuration());
         Ok(Viewer {
             ctx,
             canvas,

@@ -64,14 +64,8 @@ fn assert_valid(glbs: &[PathBuf]) {
     }
 }
 
-/// Loads `urdf` in MuJoCo and PyBullet, sets every joint to `values`, and compares each link frame
-/// with `expected` (< 1 mm, < 0.1°); also checks limits and that the joints move.
-fn check_in_simulators(
-    urdf: &Path,
-    object: &ArticulatedObject,
-    values: &[f32],
-    expected: &[Affine3A],
-) -> serde_json::Value {
+/// The venv's Python with MuJoCo and PyBullet (`scripts/setup.sh` makes it).
+fn simulators_python() -> PathBuf {
     let python = std::env::var_os("ARTMESH_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join("target/pyenv/bin/python"));
@@ -80,6 +74,38 @@ fn check_in_simulators(
         "{} is missing: run scripts/setup.sh (it makes a venv with MuJoCo and PyBullet)",
         python.display()
     );
+    python
+}
+
+/// Loads `urdf` in MuJoCo and PyBullet with contacts on (`tests/sim/check_contacts.py`): at rest no
+/// movable link overlaps another by more than 5 mm, and driven one at a time each joint covers at
+/// least 90 % of its range both ways. Returns the checker's report.
+fn check_contacts(urdf: &Path) -> serde_json::Value {
+    let out = Command::new(simulators_python())
+        .arg(repo().join("tests/sim/check_contacts.py"))
+        .arg(urdf)
+        .output()
+        .expect("the venv's python runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    eprintln!("contacts: {stdout}");
+    assert!(
+        out.status.success(),
+        "{}: the twin jams or overlaps in a simulator:\n{stdout}\n{}",
+        urdf.display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&stdout).unwrap_or_default()
+}
+
+/// Loads `urdf` in MuJoCo and PyBullet, sets every joint to `values`, and compares each link frame
+/// with `expected` (< 1 mm, < 0.1°); also checks limits and that the joints move.
+fn check_in_simulators(
+    urdf: &Path,
+    object: &ArticulatedObject,
+    values: &[f32],
+    expected: &[Affine3A],
+) -> serde_json::Value {
+    let python = simulators_python();
     let joints: Vec<_> = object
         .joints
         .iter()
@@ -176,8 +202,9 @@ fn node_tree(doc: &gltf::Document) -> Vec<(String, Vec<String>)> {
 }
 
 /// Ground-truth twins (a 7-part cabinet, a 4-part oven, a 3-part table, odd names) as GLB and URDF:
-/// the validator finds no error, the GLB reads back with the twin's hierarchy, and MuJoCo and
-/// PyBullet put every link where the joints say.
+/// the validator finds no error (collision extras included), the GLB reads back with the twin's
+/// hierarchy, MuJoCo and PyBullet put every link where the joints say, and with contacts on the
+/// links neither overlap nor jam.
 #[test]
 fn truth_twins_export_valid_glbs_and_urdfs_the_simulators_follow() {
     let dir = scratch("truth");
@@ -228,12 +255,23 @@ fn truth_twins_export_valid_glbs_and_urdfs_the_simulators_follow() {
             .sum();
         assert_eq!(channels, moving, "{category}");
 
+        // Every link's node carries its convex collision pieces in extras.
+        for node in gltf.document.nodes() {
+            let extras = node.extras().as_ref().map(|r| r.get()).unwrap_or("{}");
+            let extras: serde_json::Value = serde_json::from_str(extras).unwrap();
+            let pieces = extras["collision"].as_array().map_or(0, Vec::len);
+            assert!(pieces > 0, "{category}: node {:?}: {extras}", node.name());
+        }
+
         // The URDF in both simulators, every joint at its end value.
         write_dir(&files.urdf, &here.join("urdf")).unwrap();
         let motions: Vec<Affine3A> = twin.joints.iter().map(joint_transform).collect();
         let expected = moved_link_frames(&twin, &motions);
         let report = check_in_simulators(&here.join("urdf/twin.urdf"), &object, &end, &expected);
         assert!(report.is_object(), "{category}: {report}");
+        // With contacts on, the convex pieces neither overlap at rest nor jam a joint.
+        let contacts = check_contacts(&here.join("urdf/twin.urdf"));
+        assert_eq!(contacts["ok"], true, "{category}: {contacts}");
 
         // Names: escaped in the URDF (our reader gives them back), sanitised as the zip's folder.
         let back = ArticulatedObject::from_urdf("twin.urdf", &files.urdf).unwrap();
@@ -307,6 +345,8 @@ fn fitted_twin_exports_follow_the_fitted_motions_in_the_simulators() {
         .collect();
     let expected = moved_link_frames(&twin, &motions);
     check_in_simulators(&dir.join("urdf/twin.urdf"), &object, &end, &expected);
+    let contacts = check_contacts(&dir.join("urdf/twin.urdf"));
+    assert_eq!(contacts["ok"], true, "{contacts}");
 }
 
 /// Rendering a procedural object and its URDF export (read back with our importer) gives identical
