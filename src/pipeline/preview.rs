@@ -1,10 +1,11 @@
-//! `preview.png`: the fitted twin beside the photos, from three of each state's held-out cameras
-//! (training cameras when the dataset has no test split), as [`crate::render::preview`] draws it.
+//! `preview.png`: the fitted twin beside the photos (and the ground truth, when the dataset has
+//! it), from three of each state's held-out cameras (training cameras when the dataset has no test
+//! split), as [`crate::render::preview`] draws it.
 
 use crate::data::{Dataset, PngPixels, Split, State, encode_png};
 use crate::export::Twin;
 use crate::gpu::GpuContext;
-use crate::render::{PreviewView, preview};
+use crate::render::{PreviewTruth, PreviewView, preview};
 
 use super::PipelineError;
 
@@ -44,11 +45,19 @@ pub async fn preview_png(
     twin: &Twin,
 ) -> Result<Vec<u8>, PipelineError> {
     let [start, end] = State::ALL.map(|s| views(dataset, s));
+    let truth = match (&dataset.gt_meshes[0], &dataset.gt_joints) {
+        (Some(meshes), Some(joints)) if meshes.movable.len() == joints.len() => {
+            let twin = Twin::from_truth("truth", meshes, joints);
+            Some((twin.visual_object(), twin.end_configuration()))
+        }
+        _ => None,
+    };
     let image = preview(
         ctx,
-        &twin.object(),
+        &twin.visual_object(),
         &twin.end_configuration(),
         [&start, &end],
+        truth.as_ref().map(|(object, end)| PreviewTruth { object, end }),
     )
     .await
     .map_err(|e| PipelineError::Export(format!("{PREVIEW_FILE}: {e}")))?;

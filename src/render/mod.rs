@@ -31,7 +31,7 @@ pub use dataset::{
     RenderSpec, RenderedDataset, capture_dataset, capture_truth, render_dataset,
 };
 pub use pipeline::GtRenderer;
-pub use preview::{PreviewView, preview};
+pub use preview::{PreviewTruth, PreviewView, preview};
 pub use sheet::{SheetEntry, contact_sheet, overview_camera};
 
 use glam::{Mat4, Vec3};

@@ -1,5 +1,6 @@
 //! The fit's preview: the twin, coloured by part with its joint axes, rendered from a few of the
-//! dataset's own cameras beside the photos taken from them, for both states. One picture says
+//! dataset's own cameras beside the photos taken from them (and beside the ground truth drawn the
+//! same way, when the dataset has it), for both states. One picture says
 //! whether the parts and joints came out right (`artmesh fit` writes it as `preview.png`; the page
 //! shows it).
 
@@ -23,17 +24,32 @@ pub struct PreviewView<'a> {
     pub photo: &'a RgbaImage,
 }
 
+/// A second twin drawn between each photo and the fitted twin: the ground truth, when known.
+pub struct PreviewTruth<'a> {
+    pub object: &'a ArticulatedObject,
+    /// Its end configuration (one value per joint, radians / metres).
+    pub end: &'a [f32],
+}
+
 /// Renders the preview of `object` (start: every joint at 0; end: `end`): one row per state, each
-/// of the state's `views` as a photo tile followed by the twin's tile from the same camera.
+/// of the state's `views` as a photo tile, then the `truth`'s tile (when given) and the twin's
+/// tile from the same camera.
 pub async fn preview(
     ctx: &GpuContext,
     object: &ArticulatedObject,
     end: &[f32],
     views: [&[PreviewView<'_>]; 2],
+    truth: Option<PreviewTruth<'_>>,
 ) -> GpuResult<RgbaImage> {
-    let mut scene = TwinScene::new(object.clone(), end.to_vec());
-    scene.colour_by_part = true;
-    scene.show_axes = true;
+    let scene = |object: &ArticulatedObject, end: &[f32]| {
+        let mut scene = TwinScene::new(object.clone(), end.to_vec());
+        scene.colour_by_part = true;
+        scene.show_axes = true;
+        scene
+    };
+    let mut scenes: Vec<TwinScene> = truth.iter().map(|t| scene(t.object, t.end)).collect();
+    scenes.push(scene(object, end));
+    let tiles = 1 + scenes.len() as u32;
     let columns = views.iter().map(|v| v.len()).max().unwrap_or(0).max(1);
     let first = views.iter().flat_map(|v| v.iter()).next();
     let shrink = first.map_or(1, |v| v.photo.width.div_ceil(MAX_TILE).max(1));
@@ -41,16 +57,23 @@ pub async fn preview(
         (v.photo.width / shrink, v.photo.height / shrink)
     });
     let renderer = GtRenderer::new(ctx, tw.max(1), th.max(1))?;
-    let mut sheet = Sheet::new(2 * columns as u32 * tw, 2 * th);
+    let mut sheet = Sheet::new(tiles * columns as u32 * tw, 2 * th);
     for (row, state_views) in views.iter().enumerate() {
-        scene.set_state(row == 1);
-        let meshes = scene.meshes();
+        let meshes: Vec<_> = scenes
+            .iter_mut()
+            .map(|s| {
+                s.set_state(row == 1);
+                s.meshes()
+            })
+            .collect();
         for (col, view) in state_views.iter().enumerate() {
-            let (x0, y0) = (2 * col as u32 * tw, row as u32 * th);
+            let (x0, y0) = (tiles * col as u32 * tw, row as u32 * th);
             sheet.paste(&shrunk(view.photo, shrink, tw, th), x0, y0);
             let camera = scaled(&view.camera, shrink, tw, th);
-            let render = renderer.render_view(ctx, &meshes, &camera).await?;
-            sheet.paste(&render.rgba, x0 + tw, y0);
+            for (k, m) in meshes.iter().enumerate() {
+                let render = renderer.render_view(ctx, m, &camera).await?;
+                sheet.paste(&render.rgba, x0 + (1 + k as u32) * tw, y0);
+            }
         }
     }
     Ok(sheet.image)

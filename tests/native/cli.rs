@@ -434,8 +434,8 @@ fn reconstruct_writes_part_meshes_and_a_report_and_refuses_bad_input() {
     assert!(bench["phases"]["dominant"].is_string());
 }
 
-/// `demo` ends with the twin's exports and preview (two states × three cameras × photo and twin,
-/// each tile showing the object) in its fit folder; `export` writes them again from that folder
+/// `demo` ends with the twin's exports and preview (two states × three cameras × photo, ground
+/// truth and twin, each tile showing the object) in its fit folder; `export` writes them again from that folder
 /// (the same node tree, the same archive entries), refuses to overwrite, and names what is missing.
 #[test]
 fn demo_writes_the_twin_and_export_rewrites_it() {
@@ -451,8 +451,8 @@ fn demo_writes_the_twin_and_export_rewrites_it() {
         .unwrap()
         .to_rgba8();
     let (w, h, t) = (preview.width(), preview.height(), preview.height() / 2);
-    assert_eq!(w, 3 * h, "{w}×{h}");
-    for (row, col) in (0..2).flat_map(|r| (0..6).map(move |c| (r, c))) {
+    assert_eq!(2 * w, 9 * h, "{w}×{h}");
+    for (row, col) in (0..2).flat_map(|r| (0..9).map(move |c| (r, c))) {
         let pixel = |i: u32| preview.get_pixel(col * t + i % t, row * t + i / t).0;
         let covered = (0..t * t).filter(|&i| pixel(i)[..3] != [235; 3]).count();
         assert!(covered * 50 > (t * t) as usize, "tile {row},{col} is empty");
