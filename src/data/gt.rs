@@ -76,7 +76,9 @@ impl GtJoint {
         match self.kind {
             JointKind::Revolute => {
                 let r = Affine3A::from_quat(Quat::from_axis_angle(d, value));
-                Affine3A::from_translation(self.origin) * r * Affine3A::from_translation(-self.origin)
+                Affine3A::from_translation(self.origin)
+                    * r
+                    * Affine3A::from_translation(-self.origin)
             }
             JointKind::Prismatic => Affine3A::from_translation(d * value),
         }

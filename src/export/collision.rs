@@ -423,9 +423,11 @@ fn thinnest_axis(points: &[Vec3]) -> (Vec3, f32) {
     let n = glam::DVec3::from_array(vectors[2])
         .as_vec3()
         .normalize_or(Vec3::Z);
-    let (lo, hi) = points.iter().fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &p| {
-        (lo.min(n.dot(p)), hi.max(n.dot(p)))
-    });
+    let (lo, hi) = points
+        .iter()
+        .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(n.dot(p)), hi.max(n.dot(p)))
+        });
     (n, hi - lo)
 }
 
@@ -489,7 +491,10 @@ mod tests {
         let a = ConvexPiece::hull(&box_mesh(Vec3::ZERO, Vec3::ONE).positions).unwrap();
         let b = a.transformed(&Affine3A::from_translation(Vec3::new(0.9, 0.2, 0.0)));
         let (n, depth) = overlap(&a, &b, 0.0).unwrap();
-        assert!(n.abs_diff_eq(Vec3::X, 1e-6) && (depth - 0.1).abs() < 1e-5, "{n} {depth}");
+        assert!(
+            n.abs_diff_eq(Vec3::X, 1e-6) && (depth - 0.1).abs() < 1e-5,
+            "{n} {depth}"
+        );
         assert!(overlap(&a, &b, 0.0).is_some());
         let apart = a.transformed(&Affine3A::from_translation(Vec3::new(1.01, 0.0, 0.0)));
         assert!(overlap(&a, &apart, 0.0).is_none());
@@ -510,9 +515,15 @@ mod tests {
             box_mesh(Vec3::new(0.0, 0.0, 0.0), Vec3::new(t, 0.5, 0.5)),
         ]);
         // The drawer fills the cavity a little too well: 1 mm into the walls, as a fit might.
-        let drawer = box_mesh(Vec3::new(t, t - 1e-3, t - 1e-3), Vec3::new(0.5, 0.5 - t + 1e-3, 0.3));
+        let drawer = box_mesh(
+            Vec3::new(t, t - 1e-3, t - 1e-3),
+            Vec3::new(0.5, 0.5 - t + 1e-3, 0.3),
+        );
         let opts = CollisionOptions::default();
-        let mut parts = vec![convex_pieces(&cabinet, &opts), convex_pieces(&drawer, &opts)];
+        let mut parts = vec![
+            convex_pieces(&cabinet, &opts),
+            convex_pieces(&drawer, &opts),
+        ];
         assert!(parts[0].len() >= 5, "{} cabinet pieces", parts[0].len());
         let joint = GtJoint {
             kind: GtKind::Prismatic,
@@ -530,7 +541,10 @@ mod tests {
             for a in &parts[1] {
                 let moved = a.transformed(&pose);
                 for b in &parts[0] {
-                    assert!(overlap(&moved, b, 0.5 * opts.clearance).is_none(), "at {s} cm");
+                    assert!(
+                        overlap(&moved, b, 0.5 * opts.clearance).is_none(),
+                        "at {s} cm"
+                    );
                 }
             }
         }

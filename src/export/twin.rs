@@ -132,8 +132,17 @@ impl Twin {
     }
 
     fn object_with(&self, collisions: Option<&[Vec<ConvexPiece>]>) -> ArticulatedObject {
-        let pieces = |k: usize| collisions.and_then(|c| c.get(k)).map_or(&[][..], |c| c.as_slice());
-        let mut links = vec![link(BASE_LINK.into(), self.parts.first(), Vec3::ZERO, pieces(0))];
+        let pieces = |k: usize| {
+            collisions
+                .and_then(|c| c.get(k))
+                .map_or(&[][..], |c| c.as_slice())
+        };
+        let mut links = vec![link(
+            BASE_LINK.into(),
+            self.parts.first(),
+            Vec3::ZERO,
+            pieces(0),
+        )];
         let mut joints = Vec::new();
         for (i, joint) in self.joints.iter().enumerate() {
             let k = i + 1;

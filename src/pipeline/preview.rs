@@ -57,7 +57,9 @@ pub async fn preview_png(
         &twin.visual_object(),
         &twin.end_configuration(),
         [&start, &end],
-        truth.as_ref().map(|(object, end)| PreviewTruth { object, end }),
+        truth
+            .as_ref()
+            .map(|(object, end)| PreviewTruth { object, end }),
     )
     .await
     .map_err(|e| PipelineError::Export(format!("{PREVIEW_FILE}: {e}")))?;
