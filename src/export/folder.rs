@@ -110,10 +110,12 @@ impl FitFolder {
             "metrics": metrics,
         });
         let joints_json = json(&joints, JOINTS_FILE)?.into_bytes();
-        let twin = Twin::from_fit(fit, id).map_err(|source| FolderError::Twin {
-            id: id.to_string(),
-            source,
-        })?;
+        let twin = Twin::from_fit(fit, id)
+            .map_err(|source| FolderError::Twin {
+                id: id.to_string(),
+                source,
+            })?
+            .with_visual_budget(config.max_visual_faces);
         let exports = export_twin(&twin.object(), &twin.end_configuration(), &joints_json)
             .map_err(|source| FolderError::Export {
                 id: id.to_string(),

@@ -112,6 +112,41 @@ impl Twin {
         }
     }
 
+    /// The twin with its parts' meshes decimated ([`crate::mesh::decimate`]) to `max_faces` over
+    /// all parts, each part's share in proportion to its faces (0: unchanged). A part whose rims
+    /// and islands allow no further collapse stops above its share, so the total can exceed the
+    /// budget by that much. Colours follow the vertices they were on.
+    pub fn with_visual_budget(&self, max_faces: usize) -> Twin {
+        let total: usize = self.parts.iter().map(|p| p.mesh.triangles.len()).sum();
+        if max_faces == 0 || total <= max_faces {
+            return self.clone();
+        }
+        let parts = self
+            .parts
+            .iter()
+            .map(|part| {
+                let share = part.mesh.triangles.len() * max_faces / total;
+                let d = crate::mesh::decimate(&part.mesh.positions, &part.mesh.triangles, share);
+                TwinPart {
+                    colors: part.colors.as_ref().map(|c| {
+                        d.source
+                            .iter()
+                            .map(|&s| c.get(s as usize).copied().unwrap_or([1.0; 3]))
+                            .collect()
+                    }),
+                    mesh: TriMesh {
+                        positions: d.positions,
+                        triangles: d.triangles,
+                    },
+                }
+            })
+            .collect();
+        Twin {
+            parts,
+            ..self.clone()
+        }
+    }
+
     /// Joint values at the end state (radians / metres), one per joint of [`Twin::object`].
     pub fn end_configuration(&self) -> Vec<f32> {
         self.joints.iter().map(GtJoint::urdf_motion).collect()

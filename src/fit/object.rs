@@ -12,12 +12,19 @@ use super::reconstruct::{Reconstruction, ReconstructionConfig, SurfaceSource, re
 use crate::data::{Dataset, GroundTruth, State};
 use crate::gpu::{GpuContext, GpuResult};
 
-/// Settings of both phases.
+/// Settings of both phases and of the twin the exports write.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct FitConfig {
     pub reconstruction: ReconstructionConfig,
     pub articulation: ArticulationConfig,
+    /// Most faces of the exported twin's visual meshes, over all parts (decimated beyond; 0: no
+    /// limit). The default keeps MuJoCo's and PyBullet's loading well under a second.
+    pub max_visual_faces: usize,
 }
+
+/// The default of [`FitConfig::max_visual_faces`]: MuJoCo loads a fitted twin of 30k faces with
+/// its visuals in under 0.1 s, and refuses a mesh over 200k.
+pub const DEFAULT_VISUAL_FACES: usize = 100_000;
 
 impl FitConfig {
     /// Both phases' settings of a preset.
@@ -32,6 +39,7 @@ impl FitConfig {
         Self {
             reconstruction: ReconstructionConfig::budgeted(preset, &budget),
             articulation: ArticulationConfig::budgeted(preset, &budget),
+            max_visual_faces: DEFAULT_VISUAL_FACES,
         }
     }
 

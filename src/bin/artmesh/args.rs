@@ -115,6 +115,10 @@ pub struct BudgetArgs {
     /// at most 256) [default: 48].
     #[arg(long)]
     close_holes: Option<usize>,
+    /// Decimate the exported twin's visual meshes to at most this many faces over all parts (0: no
+    /// limit) [default: 100000].
+    #[arg(long)]
+    max_visual_faces: Option<usize>,
 }
 
 impl BudgetArgs {
@@ -144,6 +148,9 @@ impl BudgetArgs {
                 ));
             }
             config.reconstruction.close_holes = n;
+        }
+        if let Some(n) = self.max_visual_faces {
+            config.max_visual_faces = n;
         }
         Ok(config)
     }
