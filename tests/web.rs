@@ -340,7 +340,7 @@ async fn a_tiny_fit_finds_the_laptop_hinge_in_the_browser() {
         "laptop/twin.urdf",
         "laptop/joints.json",
         "laptop/twin.glb",
-        "laptop/meshes/part_1_collision.stl",
+        "laptop/meshes/part_1_collision_0.stl",
     ] {
         assert!(names.iter().any(|n| n == want), "{want} not in {names:?}");
     }

@@ -180,6 +180,15 @@ function chamfer(c) {
   return `${fmtNum(c.cd_peer, 3)}${mm}`;
 }
 
+/** One summary row: the metric's name, its value and what it measures (shown, so it also reads on touch). */
+function metricRow(tbody, name, value, what) {
+  const tr = row(tbody, [name, value, what]);
+  tr.cells[0].title = what;
+  return tr;
+}
+
+const scaled = (v, k) => (v == null ? null : v * k);
+
 function fillMetrics(m) {
   const box = $("metrics-box");
   const tbody = $("metrics").querySelector("tbody");
@@ -189,22 +198,67 @@ function fillMetrics(m) {
   let types = "—";
   if (n != null && m.type_errors != null) types = `${n - m.type_errors} of ${n}`;
   else if (m.type_accuracy != null) types = `${(m.type_accuracy * 100).toFixed(0)} %`;
-  row(tbody, ["Axis Ang (°)", fmtNum(m.axis_ang, 3)]);
-  row(tbody, ["Axis Pos (0.1 m)", fmtNum(m.axis_pos, 3)]);
-  row(tbody, ["Part Motion (° or m)", fmtNum(m.part_motion, 3)]);
-  row(tbody, ["CD-s (static part)", chamfer(m.cd_s)]);
-  row(tbody, ["CD-m (movable parts)", chamfer(m.cd_m)]);
-  row(tbody, ["Joint types right", types]);
+  metricRow(tbody, "Axis Ang (°)", fmtNum(m.axis_ang, 3),
+    "angle between each fitted axis and the true one, mean over the joints");
+  metricRow(tbody, "Axis Pos (mm)", fmtNum(scaled(m.axis_pos, 100), 2),
+    "distance between each fitted hinge line and the true one (hinges only), mean");
+  metricRow(tbody, "Part Motion, hinges (°)", fmtNum(m.part_motion_revolute, 3),
+    "how far each fitted turn is from the true turn, mean over hinges");
+  metricRow(tbody, "Part Motion, slides (mm)", fmtNum(scaled(m.part_motion_prismatic, 1000), 2),
+    "how far each fitted slide is from the true slide, mean over slides");
+  metricRow(tbody, "CD-s (mm)", m.cd_s?.cd_mm != null ? fmtNum(m.cd_s.cd_mm, 1) : "—",
+    "Chamfer distance between the fitted and the true static part: mean distance from each surface to the other");
+  metricRow(tbody, "CD-m (mm)", m.cd_m?.cd_mm != null ? fmtNum(m.cd_m.cd_mm, 1) : "—",
+    "the same for the movable parts, mean over parts");
+  metricRow(tbody, "Joint types right", types, "hinge or slide, as the truth has it");
   box.hidden = false;
 }
 
-function fillJoints(joints) {
-  const tbody = $("joints-table").querySelector("tbody");
+/** A joint's motion in its unit: degrees for a hinge, centimetres for a slide. */
+const motionText = (j) => (j.type === "prismatic" ? `${fmtNum(j.motion * 100, 1)} cm` : `${fmtNum(j.motion, 1)}°`);
+
+/** An error cell: the text, and the number (in the shown unit) for scripts and tests. */
+function errorCell(tr, value, digits, unit) {
+  const cell = tr.insertCell();
+  cell.textContent = value == null ? "—" : `${fmtNum(value, digits)} ${unit}`;
+  if (value != null) cell.dataset.value = String(value);
+  return cell;
+}
+
+/**
+ * The joints table: each fitted joint, and when the truth is known the true joint below it, with
+ * the errors report.json's metrics give (axis angle in °, hinge line distance in mm, motion in °
+ * for a hinge and mm for a slide).
+ */
+function fillJoints(joints, truth, scored) {
+  const table = $("joints-table");
+  const tbody = table.querySelector("tbody");
   tbody.replaceChildren();
-  for (const j of joints) {
-    const motion = j.type === "prismatic" ? `${fmtNum(j.motion * 100, 1)} cm` : `${fmtNum(j.motion, 1)}°`;
-    row(tbody, [String(j.part), j.type, vec(j.direction), j.type === "prismatic" ? "—" : vec(j.origin), motion]);
-  }
+  const known = Array.isArray(truth) && truth.length > 0;
+  table.classList.toggle("with-truth", known);
+  joints.forEach((j, i) => {
+    const m = Array.isArray(scored) ? scored.find((s) => s.pred === i) : null;
+    const tr = row(tbody, [String(j.part), "fitted", j.type, vec(j.direction),
+      j.type === "prismatic" ? "—" : vec(j.origin), motionText(j)]);
+    tr.dataset.joint = String(i);
+    if (!known) return;
+    errorCell(tr, m?.axis_ang, 2, "°").dataset.metric = "axis_ang";
+    errorCell(tr, scaled(m?.axis_pos, 100), 2, "mm").dataset.metric = "axis_pos";
+    const prismatic = m?.gt_kind === "prismatic";
+    errorCell(tr, m ? (prismatic ? m.part_motion * 1000 : m.part_motion) : null, 2, prismatic ? "mm" : "°")
+      .dataset.metric = "part_motion";
+    let t = m ? truth[m.gt] : null;
+    // An axis and its opposite with the opposite motion are one joint: show the truth the fitted way round.
+    const dot = (a, b) => (Array.isArray(a) && Array.isArray(b) ? a[0] * b[0] + a[1] * b[1] + a[2] * b[2] : 1);
+    if (t && dot(t.direction, j.direction) < 0) {
+      t = { ...t, direction: t.direction.map((x) => -x), motion: -t.motion };
+    }
+    if (t) {
+      const tt = row(tbody, ["", "true", t.type, vec(t.direction), t.type === "prismatic" ? "—" : vec(t.origin),
+        motionText(t), "", "", ""]);
+      tt.className = "truth";
+    }
+  });
 }
 
 function fillWarnings(warnings) {
@@ -297,7 +351,7 @@ export async function showResult(ViewerClass, fitResult) {
   $("result-empty").hidden = true;
   $("result-body").hidden = false;
   fillMetrics(report.metrics ?? null);
-  fillJoints(joints);
+  fillJoints(joints, report.truth ?? null, report.metrics?.joints ?? null);
   fillWarnings(report.warnings);
   showPreview(fitResult);
 

@@ -19,7 +19,7 @@ pub const REPORT_FILE: &str = "report.json";
 #[derive(Debug, Clone)]
 pub struct FitFolder {
     /// `report.json`: the configuration, joints, warnings, curves, reconstruction quality and,
-    /// with ground truth, the metrics.
+    /// with ground truth, the metrics and the true joints (`truth`).
     pub report: serde_json::Value,
     pub joints: Vec<JointRecord>,
     /// The scores against the dataset's ground truth, when it has GT joints.
@@ -68,6 +68,30 @@ pub enum FolderError {
     },
 }
 
+/// The dataset's true joints, when it has them, in `joints.json`'s units (degrees or metres) and
+/// field names, for the page's fitted-beside-true table.
+fn truth_records(dataset: &Dataset) -> Option<Vec<serde_json::Value>> {
+    let joints = dataset.gt_joints.as_ref()?;
+    Some(
+        joints
+            .iter()
+            .enumerate()
+            .map(|(i, j)| {
+                serde_json::json!({
+                    "part": i + 1,
+                    "type": match j.kind {
+                        crate::data::JointKind::Revolute => "revolute",
+                        crate::data::JointKind::Prismatic => "prismatic",
+                    },
+                    "direction": j.unit_direction().to_array(),
+                    "origin": j.origin.to_array(),
+                    "motion": j.motion(),
+                })
+            })
+            .collect(),
+    )
+}
+
 fn json(value: &impl Serialize, what: &'static str) -> Result<String, FolderError> {
     serde_json::to_string_pretty(value).map_err(|source| FolderError::Serialise { what, source })
 }
@@ -108,6 +132,7 @@ impl FitFolder {
             },
             "reconstruction": quality,
             "metrics": metrics,
+            "truth": truth_records(dataset),
         });
         let joints_json = json(&joints, JOINTS_FILE)?.into_bytes();
         let twin = Twin::from_fit(fit, id)

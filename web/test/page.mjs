@@ -308,6 +308,24 @@ try {
     check(Array.isArray(joints) && joints.length === count, `joints.json lists ${joints.length} joints (sliders: ${count})`);
     const rep = JSON.parse(await readFile(saved["report.json"], "utf8"));
     check(rep && typeof rep === "object", `report.json parses (${Object.keys(rep).length} fields)`);
+    // The joints table's errors are report.json's, in the table's units (°, mm).
+    const shownErrors = await page.$$eval("#joints-table tbody tr[data-joint] td[data-metric]", (cells) =>
+      cells.map((c) => ({ joint: Number(c.parentElement.dataset.joint), metric: c.dataset.metric,
+        value: Number(c.dataset.value) })));
+    const wanted = [];
+    for (const m of rep.metrics?.joints ?? []) {
+      wanted.push({ joint: m.pred, metric: "axis_ang", value: m.axis_ang });
+      if (m.axis_pos != null) wanted.push({ joint: m.pred, metric: "axis_pos", value: m.axis_pos * 100 });
+      wanted.push({ joint: m.pred, metric: "part_motion",
+        value: m.gt_kind === "prismatic" ? m.part_motion * 1000 : m.part_motion });
+    }
+    const sameError = (w) => shownErrors.some((c) => c.joint === w.joint && c.metric === w.metric &&
+      Math.abs(c.value - w.value) <= 1e-9 * Math.max(1, Math.abs(w.value)));
+    check(wanted.length > 0 && wanted.every(sameError),
+      `the joints table shows report.json's per-joint errors (${wanted.length} values, ${shownErrors.length} shown)`);
+    const trueRows = await page.locator("#joints-table tr.truth").count();
+    check(trueRows === (rep.metrics?.joints ?? []).length && (rep.truth ?? []).length > 0,
+      `each fitted joint has its true joint under it (${trueRows} rows; report.json's truth: ${(rep.truth ?? []).length})`);
   });
 
   // 6. malformed datasets ------------------------------------------------------------------
