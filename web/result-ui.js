@@ -329,6 +329,11 @@ export function wireResultButtons() {
     try { viewer.colour_by_part(e.target.checked); } catch (err) { console.error(err); }
     requestDraw();
   });
+  $("show-truth").addEventListener("change", (e) => {
+    if (!viewer) return;
+    try { viewer.show_truth(e.target.checked); } catch (err) { console.error(err); }
+    requestDraw();
+  });
   $("show-axes").addEventListener("change", (e) => {
     if (!viewer) return;
     try { viewer.show_axes(e.target.checked); } catch (err) { console.error(err); }
@@ -380,6 +385,9 @@ export async function showResult(ViewerClass, fitResult) {
   try {
     viewer.colour_by_part($("colour-by-part").checked);
     viewer.show_axes($("show-axes").checked);
+    const truth = viewer.has_truth();
+    $("show-truth-label").hidden = !truth;
+    viewer.show_truth(truth && $("show-truth").checked);
   } catch (e) { console.error(e); }
   delete canvas.dataset.sized;
   resize();

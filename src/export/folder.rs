@@ -29,6 +29,8 @@ pub struct FitFolder {
     pub files: FileSet,
     /// The twin the exports were written from.
     pub twin: Twin,
+    /// The dataset's true joints, when it has them (the page draws their axes).
+    pub truth: Option<Vec<crate::data::GtJoint>>,
 }
 
 /// Which step of [`FitFolder::build`] failed, for which object (`id`) or file (`what`).
@@ -162,6 +164,7 @@ impl FitFolder {
             metrics,
             files,
             twin,
+            truth: dataset.gt_joints.clone(),
         })
     }
 }

@@ -23,6 +23,8 @@ const PALETTE: [[f32; 3]; 8] = [
 /// Axis rod colours: revolute orange, prismatic blue.
 const REVOLUTE_ROD: [f32; 3] = [1.0, 0.45, 0.0];
 const PRISMATIC_ROD: [f32; 3] = [0.0, 0.35, 1.0];
+/// The true axes' colour, when the truth is known: near black, apart from the fitted ones.
+pub const TRUTH_ROD: [f32; 3] = [0.05, 0.05, 0.05];
 /// Vertical field of view of the viewer's camera (radians).
 const FOV_Y: f32 = 0.7;
 
@@ -64,6 +66,10 @@ pub struct TwinScene {
     end: Vec<f32>,
     pub colour_by_part: bool,
     pub show_axes: bool,
+    /// The true joint axes (a point on each and its unit direction, world frame, fixed: every
+    /// part hangs from the base), drawn in [`TRUTH_ROD`] while `show_truth` is on.
+    pub truth_axes: Vec<(Vec3, Vec3)>,
+    pub show_truth: bool,
     centre: Vec3,
     radius: f32,
     /// Camera azimuth and elevation (radians) and distance as a multiple of the framing distance.
@@ -118,6 +124,8 @@ impl TwinScene {
             end,
             colour_by_part: false,
             show_axes: true,
+            truth_axes: Vec::new(),
+            show_truth: true,
             centre: (lo + hi) * 0.5,
             radius: ((hi - lo).length() * 0.5).max(1e-3),
             yaw: -1.05,
@@ -200,7 +208,6 @@ impl TwinScene {
         }
         if self.show_axes {
             let poses = self.object.forward_kinematics(&self.values);
-            let rod = self.radius * 1.1;
             for j in &self.joints {
                 let joint = &self.object.joints[j.index];
                 let frame = poses[joint.parent] * joint.origin;
@@ -211,20 +218,30 @@ impl TwinScene {
                 } else {
                     PRISMATIC_ROD
                 };
-                let mut mesh = box_mesh(
-                    Vec3::new(2.0 * rod, rod * 0.02, rod * 0.02),
-                    Material::default(),
-                );
-                mesh.colors = Some(vec![color; mesh.positions.len()]);
-                let place =
-                    Affine3A::from_rotation_translation(Quat::from_rotation_arc(Vec3::X, axis), at);
-                meshes.push(PartMesh {
-                    mesh: mesh.transformed(&place),
-                    part: -1,
-                });
+                meshes.push(self.rod(at, axis, color));
+            }
+        }
+        if self.show_truth {
+            for &(at, axis) in &self.truth_axes {
+                meshes.push(self.rod(at, axis.normalize_or(Vec3::X), TRUTH_ROD));
             }
         }
         meshes
+    }
+
+    /// A thin rod of `color` through `at` along unit `axis`, a little longer than the object.
+    fn rod(&self, at: Vec3, axis: Vec3, color: [f32; 3]) -> PartMesh {
+        let rod = self.radius * 1.1;
+        let mut mesh = box_mesh(
+            Vec3::new(2.0 * rod, rod * 0.02, rod * 0.02),
+            Material::default(),
+        );
+        mesh.colors = Some(vec![color; mesh.positions.len()]);
+        let place = Affine3A::from_rotation_translation(Quat::from_rotation_arc(Vec3::X, axis), at);
+        PartMesh {
+            mesh: mesh.transformed(&place),
+            part: -1,
+        }
     }
 }
 
@@ -320,6 +337,13 @@ mod tests {
         let plain = s.meshes();
         assert_eq!(plain.len(), 3);
         assert_eq!(plain[1].mesh.colors.as_ref().unwrap()[0], PALETTE[1]);
+        // The true axes are drawn, in their own colour, while asked for.
+        s.truth_axes = vec![(Vec3::ZERO, Vec3::Z)];
+        let with_truth = s.meshes();
+        assert_eq!(with_truth.len(), 4);
+        assert_eq!(with_truth[3].mesh.colors.as_ref().unwrap()[0], TRUTH_ROD);
+        s.show_truth = false;
+        assert_eq!(s.meshes().len(), 3);
     }
 
     #[test]

@@ -42,7 +42,13 @@ impl Viewer {
         let (width, height) = (canvas.width().max(1), canvas.height().max(1));
         let renderer = GtRenderer::new(&ctx, width, height).map_err(js_error)?;
         let twin = &result.0.twin;
-        let scene = TwinScene::new(twin.visual_object(), twin.end_configuration());
+        let mut scene = TwinScene::new(twin.visual_object(), twin.end_configuration());
+        if let Some(truth) = &result.0.truth {
+            scene.truth_axes = truth
+                .iter()
+                .map(|j| (j.origin, j.unit_direction()))
+                .collect();
+        }
         Ok(Viewer {
             ctx,
             canvas,
@@ -105,6 +111,16 @@ impl Viewer {
 
     pub fn show_axes(&self, on: bool) {
         self.scene.borrow_mut().show_axes = on;
+    }
+
+    /// Whether the result knows the true joints (then `show_truth` draws their axes).
+    pub fn has_truth(&self) -> bool {
+        !self.scene.borrow().truth_axes.is_empty()
+    }
+
+    /// Draws the true joint axes (near black) beside the fitted ones.
+    pub fn show_truth(&self, on: bool) {
+        self.scene.borrow_mut().show_truth = on;
     }
 
     /// Follows the canvas to a new pixel size.

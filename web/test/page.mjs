@@ -262,6 +262,45 @@ try {
     check(!a.equals(b), `moving #joint-0 from ${moved.from} to ${moved.to} changes the view (${moved.label})`);
   });
 
+  // 4b. true and fitted axes, read off the viewer's pixels ---------------------------------
+  await step("true and fitted axes", async () => {
+    const pixels = () => page.evaluate(() => {
+      const c = document.getElementById("viewer");
+      return Array.from(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
+    });
+    const toggle = async (id, on) => {
+      await page.evaluate(([id, on]) => {
+        const el = document.getElementById(id);
+        el.checked = on;
+        el.dispatchEvent(new Event("change", { bubbles: true }));
+      }, [id, on]);
+      await page.waitForTimeout(700);
+    };
+    if (!check(await page.locator("#show-truth-label").isVisible(), "the true-axes toggle is offered for the demo")) return;
+    await toggle("show-axes", true);
+    await toggle("show-truth", true);
+    const both = await pixels();
+    await toggle("show-truth", false);
+    const fitted = await pixels();
+    await toggle("show-axes", false);
+    const none = await pixels();
+    await toggle("show-axes", true);
+    await toggle("show-truth", true);
+    // Pixels that change when a set of axes goes: dark ones for the truth, coloured ones for the fit.
+    const changed = (a, b, keep) => {
+      let n = 0;
+      for (let i = 0; i < a.length; i += 4) {
+        if (Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) > 60 &&
+          keep(a[i], a[i + 1], a[i + 2])) n++;
+      }
+      return n;
+    };
+    const dark = changed(both, fitted, (r, g, b) => Math.max(r, g, b) < 70);
+    const coloured = changed(fitted, none, (r, g, b) => Math.max(r, g, b) - Math.min(r, g, b) > 80);
+    check(dark > 30, `the true axes are drawn, in black (${dark} dark pixels go with them)`);
+    check(coloured > 30, `the fitted axes are drawn, in colour (${coloured} coloured pixels go with them)`);
+  });
+
   // 5. downloads ---------------------------------------------------------------------------
   await step("downloads", async () => {
     const saved = {};
