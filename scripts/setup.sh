@@ -48,9 +48,9 @@ if [ -n "$want" ]; then
   fi
 fi
 
-# npm packages of web/ (package-lock.json): playwright-core for the page test, gltf-validator for the
+# npm packages of web/ (package-lock.json): playwright-core and axe-core for the page test, gltf-validator for the
 # export tests.
-if [ ! -d web/node_modules/playwright-core ] || [ ! -d web/node_modules/gltf-validator ]; then
+if [ ! -d web/node_modules/playwright-core ] || [ ! -d web/node_modules/gltf-validator ] || [ ! -d web/node_modules/axe-core ]; then
   echo "setup: installing web/ npm packages"
   (cd web && npm ci --no-audit --no-fund --loglevel=error)
 fi

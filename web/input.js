@@ -187,12 +187,9 @@ export function setupInput(DatasetClass, { onDataset, onProblems }) {
     zone.addEventListener(type, (e) => { e.preventDefault(); zone.classList.add("over"); });
   }
   zone.addEventListener("dragleave", () => zone.classList.remove("over"));
-  // From the keyboard the zone is a button for the folder picker (Tab on reaches the .zip one).
-  zone.addEventListener("keydown", (e) => {
-    if (e.target !== zone || (e.key !== "Enter" && e.key !== " ")) return;
-    e.preventDefault();
-    $("folder").click();
-  });
+  // From the keyboard, Tab reaches the two pickers inside the zone ("a folder", "a .zip"), and Enter
+  // or Space opens them: the zone itself is only a drop target (a button around them would nest
+  // controls, which screen readers cannot announce).
   zone.addEventListener("drop", (e) => {
     e.preventDefault();
     zone.classList.remove("over");

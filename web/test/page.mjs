@@ -92,6 +92,19 @@ try {
   page.on("console", (m) => m.type() === "error" && console.log("page console:", m.text()));
   page.on("pageerror", (e) => { pageErrors.push(e.message); console.log("page error:", e.message); });
   const body = () => page.evaluate(() => ({ ...document.body.dataset }));
+  // axe-core's serious and critical violations on the page as it is now. Its source is evaluated through
+  // the DevTools protocol: no request, and the page's script policy (no inline scripts) stays as it is.
+  const axeSource = await readFile(fileURLToPath(new URL("../node_modules/axe-core/axe.min.js", import.meta.url)), "utf8");
+  const accessibility = async (label) => {
+    if (!(await page.evaluate(() => "axe" in window))) await page.evaluate(axeSource);
+    const found = await page.evaluate(async () => {
+      const r = await window.axe.run(document, { resultTypes: ["violations"] });
+      return r.violations.filter((v) => ["serious", "critical"].includes(v.impact))
+        .map((v) => `${v.id} (${v.impact}, ${v.nodes.length}×, e.g. ${v.nodes[0]?.target?.join(" ")})`);
+    });
+    check(found.length === 0, `axe-core: ${found.length} serious or critical violations on ${label}` +
+      (found.length ? ": " + found.join("; ") : ""));
+  };
   const clearFlags = (...names) => page.evaluate((names) => { for (const n of names) delete document.body.dataset[n]; }, names);
 
   // 1. GPU ---------------------------------------------------------------------------------
@@ -113,6 +126,7 @@ try {
     const rows = await page.locator("#selftest-table tbody tr").count();
     check(rows >= 20, `self-test table shows ${rows} checks`);
     await page.screenshot({ path: artefacts + "web-selftest.png", fullPage: true });
+    await accessibility("the landing page");
   });
 
   // 2. a native demo's dataset fitted in the page ------------------------------------------
@@ -234,6 +248,7 @@ try {
     const visible = await page.locator("#metrics").isVisible();
     const rows = await page.locator("#metrics tbody tr").count();
     check(visible && rows >= 3, `metrics table shown with ${rows} rows`);
+    await accessibility("the result view");
     await page.screenshot({ path: artefacts + "web-result.png", fullPage: true });
     await page.locator("#result").screenshot({ path: artefacts + "web-result-section.png" });
   });
