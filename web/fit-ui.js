@@ -204,7 +204,11 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what) {
   }
 }
 
-/** Marks the fit done (called by the app once the result is stored). */
+/** Marks the fit done (called by the app once the result is stored). The panel said the last
+ * progress event's stage, which is often the reconstruction's: joints the depth maps settle send none. */
 export function markFitDone() {
   setFit("done");
+  text("fit-stage", "finished: every stage ran");
+  text("fit-phase", "done");
+  for (const li of $("stages").children) li.classList.remove("current");
 }

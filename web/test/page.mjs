@@ -248,6 +248,8 @@ try {
     const visible = await page.locator("#metrics").isVisible();
     const rows = await page.locator("#metrics tbody tr").count();
     check(visible && rows >= 3, `metrics table shown with ${rows} rows`);
+    const stage = await page.locator("#fit-stage").textContent();
+    check(stage.startsWith("finished"), `the fit panel says the fit finished (stage: ${stage})`);
     await accessibility("the result view");
     await page.screenshot({ path: artefacts + "web-result.png", fullPage: true });
     await page.locator("#result").screenshot({ path: artefacts + "web-result-section.png" });
