@@ -214,6 +214,9 @@ function fillMetrics(m) {
   box.hidden = false;
 }
 
+/** The dot product of two 3-vectors (1 when either is missing, so nothing is flipped). */
+const dot3 = (a, b) => (Array.isArray(a) && Array.isArray(b) ? a[0] * b[0] + a[1] * b[1] + a[2] * b[2] : 1);
+
 /** A joint's motion in its unit: degrees for a hinge, centimetres for a slide. */
 const motionText = (j) => (j.type === "prismatic" ? `${fmtNum(j.motion * 100, 1)} cm` : `${fmtNum(j.motion, 1)}°`);
 
@@ -249,8 +252,7 @@ function fillJoints(joints, truth, scored) {
       .dataset.metric = "part_motion";
     let t = m ? truth[m.gt] : null;
     // An axis and its opposite with the opposite motion are one joint: show the truth the fitted way round.
-    const dot = (a, b) => (Array.isArray(a) && Array.isArray(b) ? a[0] * b[0] + a[1] * b[1] + a[2] * b[2] : 1);
-    if (t && dot(t.direction, j.direction) < 0) {
+    if (t && dot3(t.direction, j.direction) < 0) {
       t = { ...t, direction: t.direction.map((x) => -x), motion: -t.motion };
     }
     if (t) {

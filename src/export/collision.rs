@@ -406,23 +406,10 @@ fn separate(
 
 /// Unit direction of least spread of `points` and the spread along it (max − min, m).
 fn thinnest_axis(points: &[Vec3]) -> (Vec3, f32) {
-    if points.len() < 2 {
+    let Some(frame) = crate::articulation::init::principal_frame(points) else {
         return (Vec3::Z, 0.0);
-    }
-    let mean = points.iter().copied().sum::<Vec3>() / points.len() as f32;
-    let mut cov = [[0.0f64; 3]; 3];
-    for p in points {
-        let d = (*p - mean).as_dvec3().to_array();
-        for (r, row) in cov.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v += d[r] * d[c];
-            }
-        }
-    }
-    let (_, vectors) = crate::articulation::init::symmetric_eigen(cov);
-    let n = glam::DVec3::from_array(vectors[2])
-        .as_vec3()
-        .normalize_or(Vec3::Z);
+    };
+    let n = frame.axes.z_axis.as_vec3().normalize_or(Vec3::Z);
     let (lo, hi) = points
         .iter()
         .fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), &p| {

@@ -81,10 +81,7 @@ fn truth_records(dataset: &Dataset) -> Option<Vec<serde_json::Value>> {
             .map(|(i, j)| {
                 serde_json::json!({
                     "part": i + 1,
-                    "type": match j.kind {
-                        crate::data::JointKind::Revolute => "revolute",
-                        crate::data::JointKind::Prismatic => "prismatic",
-                    },
+                    "type": j.kind,
                     "direction": j.unit_direction().to_array(),
                     "origin": j.origin.to_array(),
                     "motion": j.motion(),

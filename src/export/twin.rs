@@ -142,8 +142,9 @@ impl Twin {
             })
             .collect();
         Twin {
+            name: self.name.clone(),
             parts,
-            ..self.clone()
+            joints: self.joints.clone(),
         }
     }
 

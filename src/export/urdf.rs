@@ -254,29 +254,19 @@ fn flat_bounds(
     triangles: &[[u32; 3]],
 ) -> Option<(glam::Vec3, glam::Vec3)> {
     let used: BTreeSet<u32> = triangles.iter().flatten().copied().collect();
-    let points: Vec<glam::DVec3> = used
+    let points: Vec<glam::Vec3> = used
         .iter()
-        .map(|&i| positions[i as usize].as_dvec3())
+        .map(|&i| positions[i as usize])
         .filter(|p| p.is_finite())
         .collect();
     let (lo, hi) = points
         .iter()
-        .fold(None, |acc: Option<(glam::DVec3, glam::DVec3)>, &p| {
+        .fold(None, |acc: Option<(glam::Vec3, glam::Vec3)>, &p| {
             Some(acc.map_or((p, p), |(lo, hi)| (lo.min(p), hi.max(p))))
         })?;
-    let mean = points.iter().sum::<glam::DVec3>() / points.len() as f64;
-    let mut cov = [[0.0; 3]; 3];
-    for p in &points {
-        let d = (*p - mean).to_array();
-        for (r, row) in cov.iter_mut().enumerate() {
-            for (c, v) in row.iter_mut().enumerate() {
-                *v += d[r] * d[c] / points.len() as f64;
-            }
-        }
-    }
-    let (eigen, _) = crate::articulation::init::symmetric_eigen(cov);
-    let thinnest = eigen[2].max(0.0).sqrt();
-    (points.len() < 4 || thinnest < 1e-4).then(|| (lo.as_vec3(), hi.as_vec3()))
+    let thinnest = crate::articulation::init::principal_frame(&points)
+        .map_or(0.0, |f| f.variances.z.max(0.0).sqrt());
+    (points.len() < 4 || thinnest < 1e-4).then_some((lo, hi))
 }
 
 /// Binary STL of a triangle list (facet normals from the winding).

@@ -64,8 +64,10 @@ fn assert_valid(glbs: &[PathBuf]) {
     }
 }
 
-/// The venv's Python with MuJoCo and PyBullet (`scripts/setup.sh` makes it).
-fn simulators_python() -> PathBuf {
+/// Runs `tests/sim/<script>` with `args` in the venv `scripts/setup.sh` makes (MuJoCo and
+/// PyBullet); fails with `trouble`, the output and the errors unless it passes. Returns its JSON
+/// report.
+fn run_simulator_check(script: &str, args: &[&Path], trouble: &str) -> serde_json::Value {
     let python = std::env::var_os("ARTMESH_PYTHON")
         .map(PathBuf::from)
         .unwrap_or_else(|| repo().join("target/pyenv/bin/python"));
@@ -74,27 +76,31 @@ fn simulators_python() -> PathBuf {
         "{} is missing: run scripts/setup.sh (it makes a venv with MuJoCo and PyBullet)",
         python.display()
     );
-    python
+    let out = Command::new(&python)
+        .arg(repo().join("tests/sim").join(script))
+        .args(args)
+        .output()
+        .expect("the venv's python runs");
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    eprintln!("{script}: {stdout}");
+    assert!(
+        out.status.success(),
+        "{}: {trouble}:\n{stdout}\n{}",
+        args[0].display(),
+        String::from_utf8_lossy(&out.stderr)
+    );
+    serde_json::from_str(&stdout).unwrap_or_default()
 }
 
 /// Loads `urdf` in MuJoCo and PyBullet with contacts on (`tests/sim/check_contacts.py`): at rest no
 /// movable link overlaps another by more than 5 mm, and driven one at a time each joint covers at
 /// least 90 % of its range both ways. Returns the checker's report.
 fn check_contacts(urdf: &Path) -> serde_json::Value {
-    let out = Command::new(simulators_python())
-        .arg(repo().join("tests/sim/check_contacts.py"))
-        .arg(urdf)
-        .output()
-        .expect("the venv's python runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    eprintln!("contacts: {stdout}");
-    assert!(
-        out.status.success(),
-        "{}: the twin jams or overlaps in a simulator:\n{stdout}\n{}",
-        urdf.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_str(&stdout).unwrap_or_default()
+    run_simulator_check(
+        "check_contacts.py",
+        &[urdf],
+        "the twin jams or overlaps in a simulator",
+    )
 }
 
 /// Loads `urdf` in MuJoCo and PyBullet, sets every joint to `values`, and compares each link frame
@@ -105,7 +111,6 @@ fn check_in_simulators(
     values: &[f32],
     expected: &[Affine3A],
 ) -> serde_json::Value {
-    let python = simulators_python();
     let joints: Vec<_> = object
         .joints
         .iter()
@@ -147,21 +152,11 @@ fn check_in_simulators(
     });
     let expect_path = urdf.with_file_name("expect.json");
     std::fs::write(&expect_path, expect.to_string()).unwrap();
-    let out = Command::new(&python)
-        .arg(repo().join("tests/sim/check_urdf.py"))
-        .arg(urdf)
-        .arg(&expect_path)
-        .output()
-        .expect("the venv's python runs");
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    eprintln!("simulators: {stdout}");
-    assert!(
-        out.status.success(),
-        "{}: the simulators disagree:\n{stdout}\n{}",
-        urdf.display(),
-        String::from_utf8_lossy(&out.stderr)
-    );
-    serde_json::from_str(&stdout).unwrap_or_default()
+    run_simulator_check(
+        "check_urdf.py",
+        &[urdf, &expect_path],
+        "the simulators disagree",
+    )
 }
 
 /// A procedural object's two sampled states.

@@ -27,13 +27,12 @@ fractions reached and the overlap on the way) and exits 0 only when every check 
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import time
 from pathlib import Path
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from check_urdf import read_urdf, stdout_to_stderr  # noqa: E402
+from check_urdf import finish_report, read_urdf, stdout_to_stderr  # noqa: E402
 
 OMEGA = 2.0 * 3.141592653589793  # actuator natural frequency (rad/s)
 
@@ -248,13 +247,7 @@ def main(argv: list[str] | None = None) -> int:
             report[sim] = res.as_json()
             report[sim]["total_s"] = round(time.perf_counter() - t0, 3)
             failures += [f"{sim}: {f}" for f in res.failures]
-        report["ok"] = not failures
-        report["failures"] = failures
-        for f in failures:
-            print(f"check_contacts: FAIL {f}", file=sys.stderr)
-        json.dump(report, real_stdout, indent=1)
-        real_stdout.write("\n")
-        return 0 if not failures else 1
+        return finish_report("check_contacts", report, failures, real_stdout)
 
 
 if __name__ == "__main__":

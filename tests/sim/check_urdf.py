@@ -712,6 +712,18 @@ def stdout_to_stderr():
         os.close(saved)
 
 
+def finish_report(tool: str, report: dict, failures: list[str], real_stdout) -> int:
+    """Adds the verdict to `report`, prints each failure on stderr and the report on stdout; the
+    exit status: 0 when nothing failed, else 1."""
+    report["ok"] = not failures
+    report["failures"] = failures
+    for f in failures:
+        print(f"{tool}: FAIL {f}", file=sys.stderr)
+    json.dump(report, real_stdout, indent=1)
+    real_stdout.write("\n")
+    return 0 if not failures else 1
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("urdf", type=Path)
@@ -756,14 +768,8 @@ def main(argv: list[str] | None = None) -> int:
             failures += [f"{sim}: {f}" for f in res.failures]
             for note in res.notes:
                 print(f"check_urdf: note: {sim}: {note}", file=sys.stderr)
-        report["ok"] = not failures
-        report["failures"] = failures
         report["total_s"] = round(time.perf_counter() - started, 4)
-        for f in failures:
-            print(f"check_urdf: FAIL {f}", file=sys.stderr)
-        json.dump(report, real_stdout, indent=1)
-        real_stdout.write("\n")
-        return 0 if not failures else 1
+        return finish_report("check_urdf", report, failures, real_stdout)
 
 
 if __name__ == "__main__":
