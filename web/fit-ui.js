@@ -1,9 +1,12 @@
 // The Fit section: runs `fit` with pause/cancel control, shows its progress (throttled to 10
-// updates a second), the loss curves and the latest render beside its photo.
+// updates a second) on a timeline of the method's phases, the loss curves (reconstruction and
+// articulation apart) and the latest render beside its photo; the articulation's pictures go to
+// articulation-ui.js.
 // `document.body.dataset.fit` is "running" | "paused" | "done" | "cancelled" | "error";
 // `document.body.dataset.preview` becomes "1" once a preview has been drawn.
 import { $, show, errorText, drawRgba, fmtDuration, showBanner } from "./util.js";
 import { drawLogPlot } from "./plot.js";
+import { addBakeOff, resetArticulation, showMoved } from "./articulation-ui.js";
 
 const PHASES = {
   initialise: "setting up",
@@ -19,8 +22,17 @@ const PHASES = {
 const SERIES = [
   { key: "start", label: "start state", colour: "#1f5fbf" },
   { key: "end", label: "end state", colour: "#d9730d" },
-  { key: "articulation", label: "articulation", colour: "#1b8a4a" },
 ];
+const ARTICULATION_SERIES = [
+  { key: "candidates", label: "candidates (hinge and slide in turn)", colour: "#7a4fbf" },
+  { key: "refine", label: "refinement", colour: "#1b8a4a" },
+];
+// The timeline's entry of each phase (a state's reconstruction ends with "done" too).
+const TIMELINE = {
+  initialise: "reconstruction", optimise: "reconstruction", densify: "reconstruction",
+  remesh: "remeshing", recover: "remeshing",
+  candidates: "candidates", "bake-off": "bake-off", refine: "refinement",
+};
 const MAX_POINTS = 4000;
 
 let control = "run";
@@ -31,31 +43,70 @@ let dirty = false;
 let timer = null;
 let lastUpdate = 0;
 let points = {};
+let decideAt = 0;           // articulation steps before the bake-off (the candidates')
+let timeline = {};          // seconds spent per timeline entry, and the one running
+let lastEntry = null, lastTime = 0;
 
 function setFit(state) {
   document.body.dataset.fit = state;
 }
 
-function seriesKey(ev) {
-  if (ev.stage === "articulation" || ev.stage === "bake-off decision" || ev.state === "both") return "articulation";
-  return ev.state === "end" ? "end" : "start";
+/** The plot point of a progress event: its series and x (fit % or articulation step), or null. */
+function plotPoint(ev) {
+  if (ev.state !== "both") return [ev.state === "end" ? "end" : "start", Number.isFinite(ev.fraction) ? ev.fraction * 100 : 0];
+  if (ev.phase === "candidates") { decideAt = Math.max(decideAt, ev.iterations ?? 0); return ["candidates", ev.iteration]; }
+  if (ev.phase === "refine") return ["refine", decideAt + ev.iteration];
+  return null;
+}
+
+/** Charges the time since the last event to the timeline entry that was running. */
+function tick(ev) {
+  const now = performance.now() / 1000;
+  if (lastEntry) timeline[lastEntry] = (timeline[lastEntry] ?? 0) + now - lastTime;
+  lastTime = now;
+  lastEntry = TIMELINE[ev.phase] ?? (ev.state === "both" ? null : lastEntry);
+  if (lastEntry) timeline[lastEntry] ??= 0;
+  if (ev.phase === "candidates" && ev.iterations === 0) timeline.noSteps = true;
 }
 
 function onEvent(ev) {
   if (!ev || typeof ev !== "object") return;
   if (ev.kind === "progress") {
     latest = ev;
+    tick(ev);
     const loss = Number(ev.loss);
-    if (ev.loss != null && loss > 0 && Number.isFinite(loss)) {
-      const x = Number.isFinite(ev.fraction) ? ev.fraction * 100 : (ev.elapsed_s ?? 0);
-      const list = points[seriesKey(ev)] ??= [];
+    const at = plotPoint(ev);
+    if (at && ev.loss != null && loss > 0 && Number.isFinite(loss)) {
+      const [key, x] = at;
+      const list = points[key] ??= [];
       list.push([x, loss]);
-      if (list.length > MAX_POINTS) points[seriesKey(ev)] = list.filter((_, i) => i % 2 === 0);
+      if (list.length > MAX_POINTS) points[key] = list.filter((_, i) => i % 2 === 0);
     }
   } else if (ev.kind === "preview") {
     latestPreview = ev;
+    showMoved(ev);
+  } else if (ev.kind === "bake-off") {
+    addBakeOff(ev);
   }
   schedule();
+}
+
+/** The timeline's entries: done ones with their seconds, the running one highlighted. */
+function drawTimeline() {
+  for (const li of $("stages").children) {
+    const key = li.dataset.stage, s = timeline[key];
+    const current = running && key === lastEntry;
+    li.classList.toggle("current", current);
+    li.classList.toggle("done", s != null && !current);
+    let when = "";
+    if (current) when = `running, ${fmtDuration(s)} so far`;
+    else if (s != null) when = `took ${fmtDuration(s)}`;
+    if (s != null && timeline.noSteps && (key === "candidates" || key === "refinement")) {
+      when += " (no image steps: the depth maps settled every joint)";
+    }
+    const span = li.querySelector(".when");
+    if (span.textContent !== when) span.textContent = when;
+  }
 }
 
 function schedule() {
@@ -92,17 +143,22 @@ function update() {
       const loss = ev.loss != null ? `, loss ${Number(ev.loss).toPrecision(4)}` : "";
       show($("fit-status"), `Running: ${(fraction * 100).toFixed(0)} % — ${ev.stage ?? ""}, ${PHASES[ev.phase] ?? ev.phase ?? ""}${loss}`);
     }
-    for (const li of $("stages").children) li.classList.toggle("current", running && li.dataset.stage === ev.stage);
   }
+  drawTimeline();
   drawLogPlot($("loss-plot"), SERIES.map((s) => ({ ...s, points: points[s.key] ?? [] })),
     { xLabel: "progress of the whole fit (%)", xMax: 100 });
+  const articulated = ARTICULATION_SERIES.map((s) => ({ ...s, points: points[s.key] ?? [] }));
+  $("articulation-plot").hidden = !articulated.some((s) => s.points.length > 0);
+  if (!$("articulation-plot").hidden) drawLogPlot($("articulation-plot"), articulated, { xLabel: "articulation step" });
   const p = latestPreview;
   if (p) {
     latestPreview = null;
     const a = drawRgba($("preview-render"), p.width, p.height, p.render);
     const b = drawRgba($("preview-target"), p.width, p.height, p.target);
     if (a && b) {
-      text("preview-caption", `${p.state} state, iteration ${p.iteration}`);
+      text("preview-caption", p.moved_by
+        ? `${p.stage}: the start state's mesh moved by the ${p.moved_by}, beside end-state view ${p.view}`
+        : `${p.stage}: ${p.state} state, iteration ${p.iteration}`);
       document.body.dataset.preview = "1";
     }
   }
@@ -110,6 +166,8 @@ function update() {
 
 function resetPanel() {
   latest = null; latestPreview = null; points = {};
+  decideAt = 0; timeline = {}; lastEntry = null; lastTime = performance.now() / 1000;
+  resetArticulation();
   for (const id of ["fit-stage", "fit-phase", "fit-state", "fit-iter", "fit-elapsed", "fit-eta", "fit-faces", "fit-vertices"]) text(id, "—");
   text("preview-caption", "");
   $("fit-progress").value = 0;
@@ -178,13 +236,12 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what) {
     $("fit-progress").value = 1;
     const seconds = (performance.now() - t0) / 1000;
     show($("fit-status"), `Done in ${fmtDuration(seconds)}.`, "ok");
-    for (const li of $("stages").children) li.classList.remove("current");
+    drawTimeline();
     return result;
   } catch (e) {
     running = false;
     dirty = true;
     update();
-    for (const li of $("stages").children) li.classList.remove("current");
     const message = errorText(e);
     if (control === "cancel" || /^cancelled/i.test(message)) {
       show($("fit-status"), "Cancelled.");
@@ -210,5 +267,5 @@ export function markFitDone() {
   setFit("done");
   text("fit-stage", "finished: every stage ran");
   text("fit-phase", "done");
-  for (const li of $("stages").children) li.classList.remove("current");
+  drawTimeline();
 }

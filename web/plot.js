@@ -16,14 +16,24 @@ function fmtTick(v) {
   return String(Number(v.toPrecision(2)));
 }
 
-export function drawLogPlot(canvas, series, { xLabel = "", xMax = null } = {}) {
+/** Linear ticks over [a, b]: about five at 1, 2 or 5 × a power of ten. */
+function linearTicks(a, b) {
+  const raw = (b - a) / 5, p = 10 ** Math.floor(Math.log10(raw));
+  const step = [1, 2, 5, 10].map((m) => m * p).find((s) => s >= raw) ?? raw;
+  const ticks = [];
+  for (let v = Math.ceil(a / step) * step; v <= b + 1e-9 * step; v += step) ticks.push(Number(v.toPrecision(6)));
+  return ticks;
+}
+
+/** Draws `series` with labelled axes: `xLabel` under the x ticks, `yLabel` up the left side. */
+export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log scale)", xMax = null } = {}) {
   const [w, h, dpr] = fitCanvas(canvas);
   const ctx = canvas.getContext("2d");
   ctx.setTransform(1, 0, 0, 1, 0, 0);
   ctx.clearRect(0, 0, w, h);
   ctx.scale(dpr, dpr);
   const W = w / dpr, H = h / dpr;
-  const pad = { l: 48, r: 10, t: 22, b: 26 };
+  const pad = { l: 60, r: 12, t: 22, b: 38 };
   const pw = Math.max(10, W - pad.l - pad.r), ph = Math.max(10, H - pad.t - pad.b);
   ctx.font = "11px system-ui, sans-serif";
 
@@ -67,7 +77,16 @@ export function drawLogPlot(canvas, series, { xLabel = "", xMax = null } = {}) {
   }
   ctx.textAlign = "center";
   ctx.textBaseline = "top";
-  ctx.fillText(xLabel, pad.l + pw / 2, pad.t + ph + 8);
+  for (const v of linearTicks(x0, x1)) {
+    ctx.fillRect(X(v) - 0.5, pad.t + ph, 1, 4);
+    ctx.fillText(String(v), X(v), pad.t + ph + 5);
+  }
+  ctx.fillText(xLabel, pad.l + pw / 2, pad.t + ph + 20);
+  ctx.save();
+  ctx.translate(11, pad.t + ph / 2);
+  ctx.rotate(-Math.PI / 2);
+  ctx.fillText(yLabel, 0, -6);
+  ctx.restore();
 
   for (const s of series) {
     ctx.strokeStyle = s.colour;

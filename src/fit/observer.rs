@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-use crate::data::State;
+use crate::data::{JointKind, State};
 use crate::gpu::{GpuError, GpuResult, sleep_ms};
 
 /// Stages of the reconstruction, in order.
@@ -106,10 +106,40 @@ pub struct Preview {
     /// Training view index and the iteration the render was taken at.
     pub view: usize,
     pub iteration: u32,
+    /// The phase the render was taken in.
+    pub phase: Phase,
+    /// In the articulation: the motions the start state's mesh is moved by before it is
+    /// rendered from the end state's view `view` ("joint seeds", "hinge candidates", "fitted
+    /// joints", …); `None` for a state's own mesh.
+    pub moved_by: Option<&'static str>,
     pub width: u32,
     pub height: u32,
     pub render: Vec<u8>,
     pub target: Vec<u8>,
+}
+
+/// One part's bake-off as a picture: the start state's mesh with only this part moved by each
+/// joint-type candidate, rendered from the end-state training view that sees the part most,
+/// beside that view's photo (RGB8, row-major), with both models' evidence.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BakeOffView {
+    /// The part (1 ..= K) and the end-state training view.
+    pub part: usize,
+    pub view: usize,
+    pub width: u32,
+    pub height: u32,
+    pub revolute: Vec<u8>,
+    pub prismatic: Vec<u8>,
+    pub target: Vec<u8>,
+    /// Mean image loss per pixel of the part over the end-state views, with each candidate.
+    pub revolute_loss: Option<f64>,
+    pub prismatic_loss: Option<f64>,
+    /// What the depth maps measured: each model's residual (m), when measured.
+    pub revolute_residual: Option<f64>,
+    pub prismatic_residual: Option<f64>,
+    /// The type that won, and what decided it (`"bake-off"`, `"depth maps"`, …).
+    pub kind: JointKind,
+    pub decided_by: &'static str,
 }
 
 /// The audience of a fit. Any `FnMut(&Progress)` closure is one that only listens.
@@ -122,6 +152,14 @@ pub trait Observer {
     }
     /// Receives the preview asked for.
     fn preview(&mut self, _preview: Preview) {}
+    /// Whether the driver shows the articulation as pictures: the start state's mesh moved by
+    /// the joint seeds and by the fitted joints, and each part's bake-off ([`BakeOffView`]).
+    /// They cost a few renders per part, so only a driver that shows them asks.
+    fn wants_articulation_views(&self) -> bool {
+        false
+    }
+    /// Receives one part's bake-off, when [`Self::wants_articulation_views`].
+    fn bake_off(&mut self, _view: BakeOffView) {}
     /// Asked at every checkpoint.
     fn command(&mut self) -> Command {
         Command::Run

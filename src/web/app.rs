@@ -11,8 +11,7 @@ use super::{budget, context, js_error};
 use crate::data::{FileSet, Split, State, read_zip, rebase_on_dataset_root};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
-use crate::fit::observer::Progress;
-use crate::fit::observer::{Command, Observer, Preview};
+use crate::fit::observer::{BakeOffView, Command, Observer, Preview, Progress};
 use crate::gpu::now_seconds;
 use crate::pipeline::preview::PREVIEW_FILE;
 use crate::pipeline::{self, FitInput, PipelineError};
@@ -237,15 +236,57 @@ impl Observer for PageObserver {
     }
 
     fn preview(&mut self, p: Preview) {
+        let moved_by = p.moved_by.map_or(JsValue::NULL, JsValue::from);
         self.send(&js_object(&[
             ("kind", "preview".into()),
             ("state", p.state.name().into()),
             ("view", number(p.view as u32)),
             ("iteration", number(p.iteration)),
+            ("phase", p.phase.name().into()),
+            ("stage", p.phase.stage().into()),
+            ("moved_by", moved_by),
             ("width", number(p.width)),
             ("height", number(p.height)),
             ("render", rgba_array(&p.render, 3).into()),
             ("target", rgba_array(&p.target, 3).into()),
+        ]));
+    }
+
+    fn wants_articulation_views(&self) -> bool {
+        true
+    }
+
+    fn bake_off(&mut self, b: BakeOffView) {
+        let opt = |v: Option<f64>| v.map_or(JsValue::NULL, JsValue::from_f64);
+        self.send(&js_object(&[
+            ("kind", "bake-off".into()),
+            ("part", number(b.part as u32)),
+            ("view", number(b.view as u32)),
+            ("width", number(b.width)),
+            ("height", number(b.height)),
+            ("revolute", rgba_array(&b.revolute, 3).into()),
+            ("prismatic", rgba_array(&b.prismatic, 3).into()),
+            ("target", rgba_array(&b.target, 3).into()),
+            ("revolute_loss", opt(b.revolute_loss)),
+            ("prismatic_loss", opt(b.prismatic_loss)),
+            (
+                "revolute_residual_mm",
+                opt(b.revolute_residual.map(|r| r * 1e3)),
+            ),
+            (
+                "prismatic_residual_mm",
+                opt(b.prismatic_residual.map(|r| r * 1e3)),
+            ),
+            (
+                "winner",
+                if b.kind == crate::data::JointKind::Revolute {
+                    "revolute"
+                } else {
+                    "prismatic"
+                }
+                .into(),
+            ),
+            ("decided_by", b.decided_by.into()),
         ]));
     }
 

@@ -7,7 +7,9 @@ use crate::common;
 use artmesh::data::{Dataset, State};
 use artmesh::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use artmesh::fit::object::{FitConfig, fit_object};
-use artmesh::fit::observer::{Command, Observer, Phase, Preview, Progress, Unobserved};
+use artmesh::fit::observer::{
+    BakeOffView, Command, Observer, Phase, Preview, Progress, Unobserved,
+};
 use artmesh::fit::preset::Preset;
 use artmesh::gpu::{GpuContext, GpuError};
 use artmesh::render::viewer::TwinScene;
@@ -42,6 +44,9 @@ struct Recorder {
     cancel_at: Option<usize>,
     /// Previews wanted (default 3).
     previews_wanted: Option<usize>,
+    /// Whether the articulation is watched as pictures, and the bake-offs heard.
+    articulation_views: bool,
+    bake_offs: Vec<BakeOffView>,
 }
 
 impl Observer for Recorder {
@@ -53,6 +58,12 @@ impl Observer for Recorder {
     }
     fn preview(&mut self, preview: Preview) {
         self.previews.push(preview);
+    }
+    fn wants_articulation_views(&self) -> bool {
+        self.articulation_views
+    }
+    fn bake_off(&mut self, view: BakeOffView) {
+        self.bake_offs.push(view);
     }
     fn command(&mut self) -> Command {
         let n = self.events.len();
@@ -99,9 +110,10 @@ fn a_heard_fit_reports_every_stage_in_order_and_its_folder_holds_the_downloads()
     let ctx = common::context();
     let config = FitConfig::preset(Preset::Tiny);
     let dataset = laptop(&ctx, &config);
-    // A preview at every checkpoint, the page's worst case.
+    // A preview at every checkpoint and the articulation in pictures, the page's worst case.
     let mut recorder = Recorder {
         previews_wanted: Some(usize::MAX),
+        articulation_views: true,
         ..Recorder::default()
     };
     let fit = pollster::block_on(fit_object(&ctx, &dataset, &config, &mut recorder)).unwrap();
@@ -132,6 +144,29 @@ fn a_heard_fit_reports_every_stage_in_order_and_its_folder_holds_the_downloads()
         "{} previews",
         recorder.previews.len()
     );
+    // The articulation in pictures: the start mesh moved by the seeds, then by the fitted joints,
+    // both from an end-state view; and the lid's bake-off, its two candidates side by side.
+    let moved = |by: &str| {
+        let p = recorder.previews.iter().find(|p| p.moved_by == Some(by));
+        p.unwrap_or_else(|| panic!("no preview moved by the {by}"))
+    };
+    let (seeds, fitted) = (moved("joint seeds"), moved("fitted joints"));
+    assert_eq!((seeds.state, fitted.phase), (State::End, Phase::Done));
+    assert_eq!(seeds.target, fitted.target, "one view, one photo");
+    assert_ne!(seeds.render, fitted.render, "the seeds are not the fit");
+    assert_eq!(recorder.bake_offs.len(), 1, "one bake-off per movable part");
+    let b = &recorder.bake_offs[0];
+    assert_eq!((b.part, b.revolute.len()), (1, b.target.len()));
+    assert_ne!(
+        b.revolute, b.prismatic,
+        "each candidate moves the lid its own way"
+    );
+    let (rot, trans) = (b.revolute_loss.unwrap(), b.prismatic_loss.unwrap());
+    assert!(
+        rot < trans,
+        "the hinge fits the lid better: {rot} vs {trans}"
+    );
+    assert_eq!(b.kind, fit.articulation.joints[0].kind);
     // Watching a fit changes nothing: unwatched, the same fit gives the same meshes and joints.
     let unwatched =
         pollster::block_on(fit_object(&ctx, &dataset, &config, &mut Unobserved)).unwrap();

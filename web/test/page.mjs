@@ -219,6 +219,43 @@ try {
     }
   });
 
+  // Screenshots mid-fit: the reconstruction at its first preview; the articulation paused at its first
+  // picture (the start mesh moved by the joint seeds), then resumed.
+  const midFit = async () => {
+    await page.waitForFunction(() => document.body.dataset.preview === "1", null, { timeout: 300_000, polling: 100 });
+    await page.locator("#fit").screenshot({ path: artefacts + "web-mid-reconstruction.png" });
+    await page.waitForFunction(() => (document.body.dataset.moved ?? "").includes("joint seeds") ||
+      document.body.dataset.result === "ready", null, { timeout: 600_000, polling: "raf" });
+    await page.click("#pause");
+    await page.waitForFunction(() => ["paused", "done", "error"].includes(document.body.dataset.fit));
+    const during = await body();
+    note(`paused ${during.moved?.includes("fitted") ? "after" : "during"} the articulation (moved: ${during.moved})`);
+    await page.locator("#fit").screenshot({ path: artefacts + "web-mid-articulation.png" });
+    if (during.fit === "paused") await page.click("#pause");
+  };
+  // The articulation's pictures: the start mesh moved by the seeds and by the fitted joints differ, and
+  // every movable part's bake-off shows two candidates that move it differently, one the winner.
+  const articulationPictures = async () => {
+    const shots = await page.evaluate(() => {
+      const data = (c) => Array.from(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
+      const differ = (a, b) => a.length === b.length && a.some((v, i) => Math.abs(v - b[i]) > 24);
+      const rows = [...document.querySelectorAll("#bake-off-table tbody tr")].map((tr) => {
+        const [rot, trans] = [...tr.querySelectorAll("td.candidate canvas")].map(data);
+        return { part: tr.dataset.part, differ: rot && trans ? differ(rot, trans) : false,
+          winners: tr.querySelectorAll("td.winner").length, text: tr.textContent };
+      });
+      const [seeds, fitted] = ["moved-seeds", "moved-fitted"].map((id) => document.getElementById(id));
+      return { rows, moved: seeds.width > 1 && fitted.width > 1 && differ(data(seeds), data(fitted)),
+        timeline: [...document.querySelectorAll("#stages li")].map((li) => `${li.dataset.stage}: ${li.querySelector(".when").textContent}`) };
+    });
+    check(shots.moved, "the articulation preview changes: the start mesh moved by the seeds, then by the fitted joints");
+    check(shots.rows.length === 2, `the bake-off panel has a row per movable part (${shots.rows.length} of 2)`);
+    for (const r of shots.rows) {
+      check(r.differ && r.winners === 1, `part ${r.part}'s bake-off: two candidates that differ, one winner (${r.text.trim()})`);
+    }
+    check(shots.timeline.every((t) => /took/.test(t)), `every phase on the timeline says how long it took (${shots.timeline.join("; ")})`);
+  };
+
   // 3. the page's demo ---------------------------------------------------------------------
   await step("browser demo", async () => {
     const def = await page.evaluate(() => window.artmeshCatalogue?.default ?? null);
@@ -231,9 +268,10 @@ try {
     await page.fill("#demo-parts", "2");
     await page.selectOption("#demo-preset", "tiny");
     await page.fill("#demo-seed", "0");
-    await clearFlags("result", "fit", "preview", "demo");
+    await clearFlags("result", "fit", "preview", "demo", "moved", "bakeOffs");
     const t0 = performance.now();
     await page.click("#demo-run");
+    await midFit();
     await page.waitForFunction(() => {
       const d = document.body.dataset;
       return d.result === "ready" || d.demo === "error" || ["error", "cancelled"].includes(d.fit) || d.state === "panic";
@@ -250,6 +288,7 @@ try {
     check(visible && rows >= 3, `metrics table shown with ${rows} rows`);
     const stage = await page.locator("#fit-stage").textContent();
     check(stage.startsWith("finished"), `the fit panel says the fit finished (stage: ${stage})`);
+    await articulationPictures();
     await accessibility("the result view");
     await page.screenshot({ path: artefacts + "web-result.png", fullPage: true });
     await page.locator("#result").screenshot({ path: artefacts + "web-result-section.png" });

@@ -9,6 +9,7 @@ use super::candidates::Candidates;
 use super::measured::Measured;
 use super::results::BakeOff;
 use super::run::Run;
+use super::show::{Verdict, show_bake_off};
 use crate::articulation::PartMotion;
 use crate::articulation::geometric::GeometricJoint;
 use crate::data::JointKind;
@@ -68,6 +69,52 @@ fn combined_kind(
     }
 }
 
+/// A trainable part's joint type from its bake-off losses `(revolute, prismatic, pixels)` and
+/// what it measured, and what decided it.
+fn decide(
+    part: usize,
+    candidates: &Candidates,
+    measured: &Measured,
+    (rot, trans, pixels): (f64, f64, usize),
+    warnings: &mut Vec<String>,
+) -> (JointKind, &'static str) {
+    let by_loss = if rot <= trans {
+        JointKind::Revolute
+    } else {
+        JointKind::Prismatic
+    };
+    match &measured.joints[part] {
+        // Both models' evidence: the measured residuals' and the bake-off's log ratios.
+        Some(g) if pixels > 0 => (
+            combined_kind(g, &candidates.revolute[part], rot, trans),
+            "the bake-off with the depth maps",
+        ),
+        _ if pixels > 0 => (by_loss, "the bake-off"),
+        Some(g) if g.observable => {
+            warnings.push(no_pixel_warning(part, "the depth maps"));
+            (g.kind, "the depth maps")
+        }
+        _ => {
+            warnings.push(no_pixel_warning(part, "the registration residuals"));
+            let c = candidates.seeds[part]
+                .as_ref()
+                .expect("trainable parts have candidates");
+            let kind = if c.registration.residual <= c.prismatic_residual {
+                JointKind::Revolute
+            } else {
+                JointKind::Prismatic
+            };
+            (kind, "the registration residuals")
+        }
+    }
+}
+
+fn no_pixel_warning(part: usize, instead: &str) -> String {
+    format!(
+        "part {part} owns no pixel in any end-state view: its joint type is decided by {instead} instead"
+    )
+}
+
 /// Decides every part's joint type: the measured type where the photometry does not run, the
 /// bake-off (with the measured evidence) where it does. Returns the decision and the stage's
 /// seconds.
@@ -98,7 +145,13 @@ pub(super) async fn bake_off(
         })
         .collect();
     let trainable = &candidates.trainable;
-    for part in (1..k).filter(|&p| trainable[p]) {
+    // A watching driver sees every measured part's bake-off too, though the depth maps decide it.
+    let show = observer.wants_articulation_views();
+    for part in 1..k {
+        let settled = measured.joints[part].is_some() && !trainable[part];
+        if !(trainable[part] || show && settled) {
+            continue;
+        }
         let only = |m: PartMotion| -> Vec<(DMat3, DVec3)> {
             (0..k)
                 .map(|p| if p == part { m } else { PartMotion::IDENTITY }.forward_affine())
@@ -112,40 +165,36 @@ pub(super) async fn bake_off(
             .forward
             .masked_loss(ctx, &run.renderer, &only(candidates.prismatic[part]), part)
             .await?;
-        let c = candidates.seeds[part]
-            .as_ref()
-            .expect("trainable parts have candidates");
-        let kind = if pixels > 0 {
-            if rot <= trans {
-                JointKind::Revolute
-            } else {
-                JointKind::Prismatic
-            }
+        let losses = (
+            (pixels > 0).then(|| rot / pixels as f64),
+            (pixels > 0).then(|| trans / pixels as f64),
+        );
+        let decided_by = if trainable[part] {
+            let (kind, decided_by) =
+                decide(part, candidates, measured, (rot, trans, pixels), warnings);
+            kinds[part] = kind;
+            bake_offs[part] = BakeOff {
+                revolute_loss: losses.0,
+                prismatic_loss: losses.1,
+                pixels,
+                kind,
+            };
+            decided_by
         } else {
-            warnings.push(format!(
-                "part {part} owns no pixel in any end-state view: its joint type is decided by the registration residuals instead"
-            ));
-            if c.registration.residual <= c.prismatic_residual {
-                JointKind::Revolute
-            } else {
-                JointKind::Prismatic
-            }
+            "the depth maps (the images' losses are shown, not used)"
         };
-        // Both models' evidence: the measured residuals' and the bake-off's log ratios.
-        let kind = match &measured.joints[part] {
-            Some(g) if pixels > 0 => combined_kind(g, &candidates.revolute[part], rot, trans),
-            Some(g) if g.observable => g.kind,
-            _ => kind,
-        };
-        kinds[part] = kind;
-        bake_offs[part] = BakeOff {
-            revolute_loss: (pixels > 0).then(|| rot / pixels as f64),
-            prismatic_loss: (pixels > 0).then(|| trans / pixels as f64),
-            pixels,
-            kind,
-        };
-        let at = run.event(Phase::BakeOff, part as u32, (k - 1) as u32, None);
-        checkpoint(observer, &at).await?;
+        if show {
+            let verdict = Verdict {
+                losses,
+                kind: kinds[part],
+                decided_by,
+            };
+            show_bake_off(run, observer, candidates, measured, part, verdict).await?;
+        }
+        if trainable[part] {
+            let at = run.event(Phase::BakeOff, part as u32, (k - 1) as u32, None);
+            checkpoint(observer, &at).await?;
+        }
     }
     let motions: Vec<PartMotion> = (0..k)
         .map(|p| match kinds[p] {

@@ -10,6 +10,7 @@ use super::measured::Measured;
 use super::moved_view::{backward_maps, forward_maps};
 use super::results::ArticulationPoint;
 use super::run::Run;
+use super::show::show_moved;
 use crate::articulation::init::{JointCandidates, initial_candidates};
 use crate::articulation::{MotionAdam, MotionMask, PartMotion, PartSums};
 use crate::data::JointKind;
@@ -162,6 +163,14 @@ pub(super) async fn train_candidates(
             });
             let at = run.event(Phase::Candidates, i + 1, decide, Some(terms.total));
             checkpoint(observer, &at).await?;
+            if observer.wants_preview() {
+                let by = if is_rot {
+                    "hinge candidates"
+                } else {
+                    "slide candidates"
+                };
+                show_moved(run, observer, motions, (Phase::Candidates, i + 1), by).await?;
+            }
         }
     }
     Ok(now_seconds() - t_candidates)

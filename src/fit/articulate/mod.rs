@@ -41,6 +41,7 @@ mod moved_view;
 mod refine;
 mod results;
 mod run;
+mod show;
 mod ssim;
 
 pub use config::{Ablation, ArticulationConfig, GeometryUse, RefineViews, UnknownOption};
@@ -63,6 +64,7 @@ use measured::measure;
 use moved_view::{MotionRenderer, MovedView};
 use refine::refine;
 use run::{Run, Schedule};
+use show::{seed_motions, show_moved};
 
 /// The reconstructions of both states, start first.
 fn frozen_states(rec: &Reconstruction) -> GpuResult<[&StateReconstruction; 2]> {
@@ -129,6 +131,17 @@ pub async fn articulate(
             s1.field.faces.len() + s2.field.faces.len(),
         ),
     };
+    if observer.wants_articulation_views() {
+        let seeds = seed_motions(&candidates);
+        show_moved(
+            &mut run,
+            observer,
+            &seeds,
+            (Phase::Candidates, 0),
+            "joint seeds",
+        )
+        .await?;
+    }
     times.candidates_s = train_candidates(&mut run, &mut candidates, observer).await?;
     let (mut decision, seconds) =
         bake_off(&mut run, &candidates, &measured, observer, &mut warnings).await?;
@@ -150,6 +163,18 @@ pub async fn articulate(
     joint_warnings(&joints, &mut warnings);
     times.total_s = now_seconds() - t0;
     let refine_steps = run.schedule.refine();
+    if observer.wants_articulation_views() {
+        let fitted: Vec<_> = (0..k)
+            .map(|p| {
+                joints
+                    .iter()
+                    .find(|j| j.part == p)
+                    .map_or(crate::articulation::PartMotion::IDENTITY, |j| j.motion)
+            })
+            .collect();
+        let at = (Phase::Done, refine_steps);
+        show_moved(&mut run, observer, &fitted, at, "fitted joints").await?;
+    }
     let done = run.event(Phase::Done, refine_steps, refine_steps, None);
     checkpoint(observer, &done).await?;
     Ok(Articulation {

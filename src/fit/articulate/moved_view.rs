@@ -10,7 +10,7 @@ use super::ssim::masked_image_loss;
 use crate::articulation::kernels::{MotionKernels, MovedMesh};
 use crate::articulation::{PartMotion, PartSums};
 use crate::data::Frame;
-use crate::fit::photometric::encode_loss_and_backward;
+use crate::fit::photometric::{encode_loss_and_backward, planes_to_rgb8, target_rgb};
 use crate::fit::reconstruct::ReconstructionConfig;
 use crate::fit::views::ViewCycle;
 use crate::gpu::{GpuContext, GpuError, GpuResult};
@@ -202,6 +202,40 @@ impl<'a> MovedView<'a> {
             )
             .await?;
         Ok(())
+    }
+
+    /// The view that sees `part` most (by its labelled pixels; view 0 when none labels it).
+    pub(super) fn view_showing(&self, part: usize) -> usize {
+        let label = part as i16;
+        let pixels = |f: &Frame| {
+            f.parts
+                .as_ref()
+                .map_or(0, |p| p.ids.iter().filter(|&&id| id == label).count())
+        };
+        (0..self.frames.len())
+            .max_by_key(|&v| (pixels(&self.frames[v]), std::cmp::Reverse(v)))
+            .unwrap_or(0)
+    }
+
+    /// The mesh moved by `motions`, rendered from view `view`, and that view's photo
+    /// (composited on the background): width, height and both as RGB8.
+    pub(super) async fn snapshot(
+        &mut self,
+        ctx: &GpuContext,
+        r: &MotionRenderer,
+        motions: &[(DMat3, DVec3)],
+        view: usize,
+    ) -> GpuResult<(u32, u32, Vec<u8>, Vec<u8>)> {
+        self.render(ctx, r, motions, view).await?;
+        let render = self.state.read_render(ctx).await?;
+        let n = (render.width * render.height) as usize;
+        let target = target_rgb(&self.frames[view], r.settings.background);
+        Ok((
+            render.width,
+            render.height,
+            planes_to_rgb8(&render.planes[..3 * n]),
+            planes_to_rgb8(&target),
+        ))
     }
 
     /// The bake-off's loss of the mesh moved by `motions` on the pixels labelled `part` in

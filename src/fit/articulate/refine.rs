@@ -12,6 +12,7 @@ use super::config::ArticulationConfig;
 use super::moved_view::{backward_maps, forward_maps};
 use super::results::ArticulationPoint;
 use super::run::Run;
+use super::show::show_moved;
 use crate::articulation::vertex_motion::{StateSurface, VertexMotionWeights, vertex_motion_loss};
 use crate::articulation::{MotionAdam, MotionMask, PartSums};
 use crate::fit::observer::{Observer, Phase, checkpoint};
@@ -130,6 +131,10 @@ pub(super) async fn refine(
             });
             let at = run.event(Phase::Refine, step + 1, refine, Some(forward_loss));
             checkpoint(observer, &at).await?;
+            if observer.wants_preview() {
+                let at = (Phase::Refine, step + 1);
+                show_moved(run, observer, motions, at, "refined joints").await?;
+            }
             // Flat: the reported objective moved by less than the tolerance since the last report.
             let objective = f64::from(forward_loss)
                 + f64::from(backward_loss.unwrap_or(0.0))

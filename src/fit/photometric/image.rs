@@ -26,7 +26,7 @@ pub(crate) fn target_rgb(frame: &Frame, background: Vec3) -> Vec<f32> {
 }
 
 /// Channel planes (all R, then all G, then all B; values in [0, 1]) as interleaved RGB8.
-pub(super) fn planes_to_rgb8(planes: &[f32]) -> Vec<u8> {
+pub(crate) fn planes_to_rgb8(planes: &[f32]) -> Vec<u8> {
     let n = planes.len() / 3;
     (0..3 * n)
         .map(|i| (planes[(i % 3) * n + i / 3].clamp(0.0, 1.0) * 255.0).round() as u8)

@@ -16,13 +16,12 @@ mod trainer;
 
 pub use adam::{FieldAdam, FieldLearningRates};
 pub use config::{CurvePoint, PhotometricConfig};
-pub(crate) use image::{encode_loss_and_backward, target_rgb};
+pub(crate) use image::{encode_loss_and_backward, planes_to_rgb8, target_rgb};
 pub use trainer::Trainer;
 
 use crate::data::{Camera, Frame};
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 use crate::raster::{GpuField, MeshField, RasterState, Rasterizer};
-use image::planes_to_rgb8;
 
 /// The fitted field and how it got there.
 #[derive(Debug, Clone)]

@@ -7,7 +7,7 @@ use super::adam::{FieldAdam, FieldLearningRates};
 use super::config::{CurvePoint, PhotometricConfig};
 use super::image::{encode_loss_and_backward, planes_to_rgb8, target_rgb};
 use crate::data::{Camera, Frame, State};
-use crate::fit::observer::Preview;
+use crate::fit::observer::{Phase, Preview};
 use crate::fit::views::ViewCycle;
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 use crate::loss::{ImageLoss, LossTerms, LossWeights, TargetImages, TargetView};
@@ -163,7 +163,7 @@ impl<'a> Trainer<'a> {
         ctx: &GpuContext,
         view: usize,
         settings: &RasterSettings,
-        (state, iteration): (State, u32),
+        (state, phase, iteration): (State, Phase, u32),
     ) -> GpuResult<Preview> {
         let (Some(camera), Some(frame)) = (self.cameras.get(view), self.frames.get(view)) else {
             return Err(GpuError::InvalidInput(format!(
@@ -188,6 +188,8 @@ impl<'a> Trainer<'a> {
             state,
             view,
             iteration,
+            phase,
+            moved_by: None,
             width: render.width,
             height: render.height,
             render: planes_to_rgb8(&render.planes[..3 * n]),

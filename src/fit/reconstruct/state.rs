@@ -75,7 +75,7 @@ impl StateRun<'_> {
     ) -> GpuResult<()> {
         checkpoint(self.observer, event).await?;
         if self.observer.wants_preview() {
-            let at = (event.state, event.iteration);
+            let at = (event.state, event.phase, event.iteration);
             let preview = trainer.preview(self.ctx, 0, settings, at).await?;
             self.observer.preview(preview);
         }
