@@ -7,13 +7,20 @@ cd "$(dirname "$0")/.."
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
 
-# --native: only what the CLI needs (a Vulkan driver); default: everything the tests need too.
-native_only=false
-[ "${1:-}" = "--native" ] && native_only=true
+# --native: only what the CLI needs (a Vulkan driver). --web: only what building and serving the page
+# needs (the wasm target, wasm-bindgen-cli, Node.js for the static server). Default: everything the
+# tests need, both of those included.
+mode=${1:-all}
+case "$mode" in
+  all|--native|--web) ;;
+  *) echo "setup: unknown option '$mode' (expected --native, --web or nothing)" >&2; exit 2 ;;
+esac
 
 need_apt=()
-dpkg -s mesa-vulkan-drivers >/dev/null 2>&1 || need_apt+=(mesa-vulkan-drivers)
-if ! $native_only; then
+[ "$mode" = --web ] || dpkg -s mesa-vulkan-drivers >/dev/null 2>&1 || need_apt+=(mesa-vulkan-drivers)
+if [ "$mode" = --web ]; then
+command -v node >/dev/null 2>&1 || need_apt+=(nodejs)
+elif [ "$mode" = all ]; then
 command -v chromium >/dev/null 2>&1 || need_apt+=(chromium)
 command -v chromedriver >/dev/null 2>&1 || need_apt+=(chromium-driver)
 command -v node >/dev/null 2>&1 || need_apt+=(nodejs)
@@ -28,15 +35,17 @@ if [ ${#need_apt[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${need_apt[@]}" >/dev/null
 fi
 
-if $native_only; then echo "setup: ok (native)"; exit 0; fi
+if [ "$mode" = --native ]; then echo "setup: ok (native)"; exit 0; fi
 
 if ! rustup target list --installed | grep -q '^wasm32-unknown-unknown$'; then
   echo "setup: adding the wasm32-unknown-unknown target"
   rustup target add wasm32-unknown-unknown
 fi
-for comp in rustfmt clippy; do
-  rustup component list --installed | grep -q "^$comp" || rustup component add "$comp"
-done
+if [ "$mode" = all ]; then
+  for comp in rustfmt clippy; do
+    rustup component list --installed | grep -q "^$comp" || rustup component add "$comp"
+  done
+fi
 
 # wasm-bindgen-cli must match the wasm-bindgen crate in Cargo.lock exactly.
 want=$(awk '/^name = "wasm-bindgen"$/{getline; gsub(/version = |"/,""); print; exit}' Cargo.lock 2>/dev/null || true)
@@ -47,6 +56,8 @@ if [ -n "$want" ]; then
     cargo install -q wasm-bindgen-cli --version "$want" --force
   fi
 fi
+
+if [ "$mode" = --web ]; then echo "setup: ok (web)"; exit 0; fi
 
 # npm packages of web/ (package-lock.json): playwright-core and axe-core for the page test, gltf-validator for the
 # export tests.

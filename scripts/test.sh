@@ -31,14 +31,16 @@ cargo test --all-targets
 step "wasm build of the page"
 # The dev profile shares its build with the browser tests below (a release build would compile
 # wgpu for wasm a second time); `web/build.sh` alone builds release for people.
-ARTMESH_WEB_PROFILE=dev web/build.sh
+# It is written as the static folder a host would get (--dist), and the page test below serves that.
+rm -rf target/web-dist
+ARTMESH_WEB_PROFILE=dev web/build.sh --dist target/web-dist
 
 step "browser tests (wasm-bindgen-test in headless Chromium, WebGPU)"
 export CHROMEDRIVER=${CHROMEDRIVER:-/usr/bin/chromedriver}
 export WASM_BINDGEN_TEST_TIMEOUT=${WASM_BINDGEN_TEST_TIMEOUT:-900}
 cargo test --target wasm32-unknown-unknown --test web
 
-step "page end-to-end test (playwright-core + Debian Chromium)"
-(cd web && node test/page.mjs)
+step "page end-to-end test (playwright-core + Debian Chromium, serving target/web-dist)"
+(cd web && ARTMESH_WEB_ROOT=../target/web-dist node test/page.mjs)
 
 step "all tests passed"

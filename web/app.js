@@ -348,4 +348,9 @@ async function main() {
   }
 }
 
+// Offline once loaded: the service worker keeps a copy of every file the page fetched.
+if ("serviceWorker" in navigator && window.isSecureContext) {
+  navigator.serviceWorker.register("sw.js").catch((e) => console.warn("service worker:", e));
+}
+
 main();

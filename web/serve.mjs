@@ -1,17 +1,20 @@
-// A static file server for web/ on 127.0.0.1 (no dependencies). Usage: node web/serve.mjs [port]
-// Imported by the browser test, which starts it on a free port.
+// A static file server on 127.0.0.1 (no dependencies) for web/ or a folder `web/build.sh --dist`
+// wrote. Usage: node web/serve.mjs [port] [folder]. Imported by the browser test, which starts it on
+// a free port.
 import { createServer } from "node:http";
 import { readFile } from "node:fs/promises";
-import { extname, join, normalize, dirname } from "node:path";
+import { extname, join, normalize, dirname, resolve } from "node:path";
 import { fileURLToPath } from "node:url";
 
-const root = dirname(fileURLToPath(import.meta.url));
+const webDir = dirname(fileURLToPath(import.meta.url));
 const types = {
   ".html": "text/html; charset=utf-8", ".js": "text/javascript", ".mjs": "text/javascript",
   ".css": "text/css", ".wasm": "application/wasm", ".json": "application/json", ".png": "image/png",
 };
 
-export function serve(port = 8000) {
+/** Serves `folder` (default web/) on `port` (0: a free one); resolves to the listening server. */
+export function serve(port = 8000, folder = webDir) {
+  const root = resolve(folder);
   const server = createServer(async (req, res) => {
     const path = normalize(decodeURIComponent(new URL(req.url, "http://x").pathname)).replace(/^(\.\.[/\\])+/, "");
     const file = join(root, path.endsWith("/") ? path + "index.html" : path);
@@ -28,6 +31,6 @@ export function serve(port = 8000) {
 }
 
 if (process.argv[1] === fileURLToPath(import.meta.url)) {
-  const server = await serve(Number(process.argv[2] ?? 8000));
-  console.log(`artmesh page: http://127.0.0.1:${server.address().port}/`);
+  const server = await serve(Number(process.argv[2] ?? 8000), process.argv[3] ?? webDir);
+  console.log(`artmesh page: http://127.0.0.1:${server.address().port}/ (serving ${resolve(process.argv[3] ?? webDir)})`);
 }

@@ -73,7 +73,9 @@ const unit = (a) => a.map((x) => x / len(a));
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
 const parse = (v) => (typeof v === "string" ? JSON.parse(v) : v);
 
-const server = await serve(0);
+// ARTMESH_WEB_ROOT: test a folder `web/build.sh --dist` wrote (CI does) instead of web/ itself.
+const webRoot = process.env.ARTMESH_WEB_ROOT ?? fileURLToPath(new URL("..", import.meta.url));
+const server = await serve(0, webRoot);
 const url = `http://127.0.0.1:${server.address().port}/`;
 const browser = await chromium.launch({
   executablePath: process.env.CHROMIUM ?? "/usr/bin/chromium",
@@ -517,9 +519,35 @@ try {
     const banner = await page.locator("#error").isVisible();
     check(!banner, `no error banner at the end${banner ? ": " + (await page.locator("#error-text").textContent()) : ""}`);
   });
+
+  // 8. the --dist folder: refuses to replace files; reopens from its service worker, host gone -
+  await step("dist folder", async () => {
+    // --dist never replaces files: a folder with something in it is refused before any build.
+    const full = join(work, "full-folder");
+    await mkdir(full);
+    await writeFile(join(full, "keep.txt"), "mine");
+    let refused = false;
+    try {
+      execFileSync("bash", [fileURLToPath(new URL("../build.sh", import.meta.url)), "--dist", full], { stdio: "pipe" });
+    } catch (e) {
+      refused = String(e.stderr).includes("not an empty folder");
+    }
+    check(refused && (await readFile(join(full, "keep.txt"), "utf8")) === "mine",
+      "web/build.sh --dist refuses a folder that has files in it and leaves them as they were");
+    await page.evaluate(() => navigator.serviceWorker.ready);
+    const isDist = await readFile(join(webRoot, "build.json")).then(() => true, () => false);
+    if (!isDist) { note("web/ itself is served (no build.json): reopening offline is checked on a --dist folder"); return; }
+    // The host goes away (emulated offline would not reach the service worker's own fetches).
+    server.close();
+    server.closeAllConnections();
+    await page.reload();
+    await page.waitForFunction(() => document.body.dataset.state !== "loading", null, { timeout: 300_000 });
+    const state = await body();
+    check(state.state === "done", `with the host gone the page reopens from its service worker and starts (state=${state.state})`);
+  });
 } finally {
   await browser.close();
-  server.close();
+  if (server.listening) server.close();
 }
 console.log("step timings: " + timings.map(([n, s]) => `${n} ${s.toFixed(1)} s`).join(", "));
 console.log(`page: ${passed} passed, ${failed} failed`);
