@@ -116,6 +116,33 @@ pub struct Preview {
     pub height: u32,
     pub render: Vec<u8>,
     pub target: Vec<u8>,
+    /// The render's parts and joint axes (the articulation's pictures; empty otherwise).
+    pub marks: Marks,
+}
+
+/// What an articulation picture shows besides its colours: the part each pixel shows and the
+/// moved parts' joint axes, in that picture's pixels, so a driver can colour and annotate it.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Marks {
+    /// Per pixel (row-major) the part it shows, 0 the base; [`Marks::EMPTY`] where nothing is.
+    pub parts: Vec<u8>,
+    pub axes: Vec<AxisMark>,
+}
+
+impl Marks {
+    /// The label of a pixel the mesh does not cover.
+    pub const EMPTY: u8 = u8::MAX;
+}
+
+/// One moved part's joint axis drawn over a picture: a hinge as a segment of its axis beside
+/// the part, a slide as the path of the part's centre (at least half the part's size long).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct AxisMark {
+    pub part: usize,
+    pub kind: JointKind,
+    /// The segment's ends in pixels (x right, y down).
+    pub from: [f32; 2],
+    pub to: [f32; 2],
 }
 
 /// One part's bake-off as a picture: the start state's mesh with only this part moved by each
@@ -131,6 +158,9 @@ pub struct BakeOffView {
     pub revolute: Vec<u8>,
     pub prismatic: Vec<u8>,
     pub target: Vec<u8>,
+    /// Each candidate's picture's parts and axis.
+    pub revolute_marks: Marks,
+    pub prismatic_marks: Marks,
     /// Mean image loss per pixel of the part over the end-state views, with each candidate.
     pub revolute_loss: Option<f64>,
     pub prismatic_loss: Option<f64>,

@@ -4,14 +4,14 @@
 
 use std::rc::Rc;
 
-use js_sys::{Array, Function, Object, Reflect, Uint8ClampedArray};
+use js_sys::{Array, Function, Object, Reflect, Uint8Array, Uint8ClampedArray};
 use wasm_bindgen::prelude::*;
 
 use super::{budget, context, js_error};
-use crate::data::{FileSet, Split, State, read_zip, rebase_on_dataset_root};
+use crate::data::{FileSet, JointKind, Split, State, read_zip, rebase_on_dataset_root};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
-use crate::fit::observer::{BakeOffView, Command, Observer, Preview, Progress};
+use crate::fit::observer::{BakeOffView, Command, Marks, Observer, Preview, Progress};
 use crate::gpu::now_seconds;
 use crate::pipeline::preview::PREVIEW_FILE;
 use crate::pipeline::{self, FitInput, PipelineError};
@@ -44,6 +44,37 @@ fn rgba_array(pixels: &[u8], channels: usize) -> Uint8ClampedArray {
             .collect()
     };
     Uint8ClampedArray::from(rgba.as_slice())
+}
+
+/// "revolute" or "prismatic", as the page names joint types.
+fn kind_name(kind: JointKind) -> &'static str {
+    match kind {
+        JointKind::Revolute => "revolute",
+        JointKind::Prismatic => "prismatic",
+    }
+}
+
+/// A picture's per-pixel parts as a `Uint8Array` (255: nothing there).
+fn marks_parts(marks: &Marks) -> JsValue {
+    Uint8Array::from(marks.parts.as_slice()).into()
+}
+
+/// A picture's axes as `[{part, kind, from: [x, y], to: [x, y]}]` in its pixels.
+fn marks_axes(marks: &Marks) -> JsValue {
+    let point = |p: [f32; 2]| -> JsValue { Array::of2(&number(p[0]), &number(p[1])).into() };
+    marks
+        .axes
+        .iter()
+        .map(|a| {
+            js_object(&[
+                ("part", number(a.part as u32)),
+                ("kind", kind_name(a.kind).into()),
+                ("from", point(a.from)),
+                ("to", point(a.to)),
+            ])
+        })
+        .collect::<Array>()
+        .into()
 }
 
 /// Pairs dropped files' paths (relative, '/'-separated) with their contents.
@@ -249,6 +280,8 @@ impl Observer for PageObserver {
             ("height", number(p.height)),
             ("render", rgba_array(&p.render, 3).into()),
             ("target", rgba_array(&p.target, 3).into()),
+            ("parts", marks_parts(&p.marks)),
+            ("axes", marks_axes(&p.marks)),
         ]));
     }
 
@@ -267,6 +300,10 @@ impl Observer for PageObserver {
             ("revolute", rgba_array(&b.revolute, 3).into()),
             ("prismatic", rgba_array(&b.prismatic, 3).into()),
             ("target", rgba_array(&b.target, 3).into()),
+            ("revolute_parts", marks_parts(&b.revolute_marks)),
+            ("revolute_axes", marks_axes(&b.revolute_marks)),
+            ("prismatic_parts", marks_parts(&b.prismatic_marks)),
+            ("prismatic_axes", marks_axes(&b.prismatic_marks)),
             ("revolute_loss", opt(b.revolute_loss)),
             ("prismatic_loss", opt(b.prismatic_loss)),
             (
@@ -277,15 +314,7 @@ impl Observer for PageObserver {
                 "prismatic_residual_mm",
                 opt(b.prismatic_residual.map(|r| r * 1e3)),
             ),
-            (
-                "winner",
-                if b.kind == crate::data::JointKind::Revolute {
-                    "revolute"
-                } else {
-                    "prismatic"
-                }
-                .into(),
-            ),
+            ("winner", kind_name(b.kind).into()),
             ("decided_by", b.decided_by.into()),
         ]));
     }

@@ -4,11 +4,11 @@
 
 use crate::common;
 
-use artmesh::data::{Dataset, State};
+use artmesh::data::{Dataset, JointKind, State};
 use artmesh::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use artmesh::fit::object::{FitConfig, fit_object};
 use artmesh::fit::observer::{
-    BakeOffView, Command, Observer, Phase, Preview, Progress, Unobserved,
+    BakeOffView, Command, Marks, Observer, Phase, Preview, Progress, Unobserved,
 };
 use artmesh::fit::preset::Preset;
 use artmesh::gpu::{GpuContext, GpuError};
@@ -167,6 +167,20 @@ fn a_heard_fit_reports_every_stage_in_order_and_its_folder_holds_the_downloads()
         "the hinge fits the lid better: {rot} vs {trans}"
     );
     assert_eq!(b.kind, fit.articulation.joints[0].kind);
+    // Marked as the page draws them: the laptop's lid's pixels, its fitted axis a hinge in view,
+    // each candidate's picture marked with its own kind.
+    let pixels = (fitted.width * fitted.height) as usize;
+    assert_eq!(fitted.marks.parts.len(), pixels);
+    assert!(fitted.marks.parts.contains(&1), "the lid is labelled");
+    let [axis] = fitted.marks.axes[..] else {
+        panic!("one axis: {:?}", fitted.marks.axes)
+    };
+    assert_eq!((axis.part, axis.kind), (1, fit.articulation.joints[0].kind));
+    let inside = |p: [f32; 2]| (0.0..fitted.width as f32).contains(&p[0]);
+    assert!(inside(axis.from) || inside(axis.to), "{axis:?}");
+    let kinds = |m: &Marks| m.axes.iter().map(|a| a.kind).collect::<Vec<_>>();
+    assert_eq!(kinds(&b.revolute_marks), [JointKind::Revolute]);
+    assert_eq!(kinds(&b.prismatic_marks), [JointKind::Prismatic]);
     // Watching a fit changes nothing: unwatched, the same fit gives the same meshes and joints.
     let unwatched =
         pollster::block_on(fit_object(&ctx, &dataset, &config, &mut Unobserved)).unwrap();

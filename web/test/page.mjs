@@ -247,10 +247,17 @@ try {
           winners: tr.querySelectorAll("td.winner").length, text: tr.textContent };
       });
       const [seeds, fitted] = ["moved-seeds", "moved-fitted"].map((id) => document.getElementById(id));
-      return { rows, moved: seeds.width > 1 && fitted.width > 1 && differ(data(seeds), data(fitted)),
+      // Pixels of the axis colours (orange hinge, blue slide) drawn over the fitted joints' picture.
+      const px = data(fitted), near = (i, c) => c.every((v, k) => Math.abs(px[i + k] - v) < 30);
+      let axisPixels = 0;
+      for (let i = 0; i < px.length; i += 4) axisPixels += near(i, [0xe8, 0x71, 0x0a]) || near(i, [0x1a, 0x73, 0xe8]);
+      return { rows, axisPixels, axes: document.body.dataset.movedAxes,
+        moved: seeds.width > 1 && fitted.width > 1 && differ(data(seeds), data(fitted)),
         timeline: [...document.querySelectorAll("#stages li")].map((li) => `${li.dataset.stage}: ${li.querySelector(".when").textContent}`) };
     });
     check(shots.moved, "the articulation preview changes: the start mesh moved by the seeds, then by the fitted joints");
+    check(shots.axes === "2" && shots.axisPixels > 50,
+      `the fitted joints' picture draws both moved parts' axes (${shots.axes} axes, ${shots.axisPixels} axis-coloured pixels)`);
     check(shots.rows.length === 2, `the bake-off panel has a row per movable part (${shots.rows.length} of 2)`);
     for (const r of shots.rows) {
       check(r.differ && r.winners === 1, `part ${r.part}'s bake-off: two candidates that differ, one winner (${r.text.trim()})`);

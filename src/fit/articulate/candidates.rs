@@ -10,7 +10,6 @@ use super::measured::Measured;
 use super::moved_view::{backward_maps, forward_maps};
 use super::results::ArticulationPoint;
 use super::run::Run;
-use super::show::show_moved;
 use crate::articulation::init::{JointCandidates, initial_candidates};
 use crate::articulation::{MotionAdam, MotionMask, PartMotion, PartSums};
 use crate::data::JointKind;
@@ -169,7 +168,8 @@ pub(super) async fn train_candidates(
                 } else {
                     "slide candidates"
                 };
-                show_moved(run, observer, motions, (Phase::Candidates, i + 1), by).await?;
+                run.show_moved(observer, motions, (Phase::Candidates, i + 1), by)
+                    .await?;
             }
         }
     }

@@ -64,7 +64,7 @@ use measured::measure;
 use moved_view::{MotionRenderer, MovedView};
 use refine::refine;
 use run::{Run, Schedule};
-use show::{seed_motions, show_moved};
+use show::seed_motions;
 
 /// The reconstructions of both states, start first.
 fn frozen_states(rec: &Reconstruction) -> GpuResult<[&StateReconstruction; 2]> {
@@ -133,14 +133,8 @@ pub async fn articulate(
     };
     if observer.wants_articulation_views() {
         let seeds = seed_motions(&candidates);
-        show_moved(
-            &mut run,
-            observer,
-            &seeds,
-            (Phase::Candidates, 0),
-            "joint seeds",
-        )
-        .await?;
+        run.show_moved(observer, &seeds, (Phase::Candidates, 0), "joint seeds")
+            .await?;
     }
     times.candidates_s = train_candidates(&mut run, &mut candidates, observer).await?;
     let (mut decision, seconds) =
@@ -173,7 +167,8 @@ pub async fn articulate(
             })
             .collect();
         let at = (Phase::Done, refine_steps);
-        show_moved(&mut run, observer, &fitted, at, "fitted joints").await?;
+        run.show_moved(observer, &fitted, at, "fitted joints")
+            .await?;
     }
     let done = run.event(Phase::Done, refine_steps, refine_steps, None);
     checkpoint(observer, &done).await?;

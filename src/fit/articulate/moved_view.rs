@@ -3,19 +3,20 @@
 //! views; what comes back are the per-part position-gradient sums of the pixel-wise motion
 //! consistency, or the bake-off's per-part masked loss.
 
-use glam::{DMat3, DVec3};
+use glam::{DMat3, DVec3, Vec3};
 
 use super::config::{ArticulationConfig, RefineViews};
 use super::ssim::masked_image_loss;
 use crate::articulation::kernels::{MotionKernels, MovedMesh};
 use crate::articulation::{PartMotion, PartSums};
-use crate::data::Frame;
+use crate::data::{Frame, JointKind};
+use crate::fit::observer::{AxisMark, Marks};
 use crate::fit::photometric::{encode_loss_and_backward, planes_to_rgb8, target_rgb};
 use crate::fit::reconstruct::ReconstructionConfig;
 use crate::fit::views::ViewCycle;
 use crate::gpu::{GpuContext, GpuError, GpuResult};
 use crate::loss::{ImageLoss, LossWeights, TargetImages, TargetView};
-use crate::raster::{GpuField, MeshField, RasterSettings, RasterState, Rasterizer};
+use crate::raster::{GpuField, MeshField, RasterSettings, RasterState, Rasterizer, RenderImages};
 use crate::rng::Rng;
 
 /// Per-part forward affine maps, part 0 (the static base) fixed.
@@ -70,6 +71,17 @@ pub(super) struct MovedView<'a> {
     targets: TargetImages,
     frames: &'a [Frame],
     views: ViewCycle,
+    /// Per part its rest centroid and size (1.5 × RMS distance to it), where axes are drawn.
+    centres: Vec<(DVec3, f64)>,
+}
+
+/// A picture of the moved mesh: width, height, the render and the photo (RGB8) and the marks.
+pub(super) struct Snapshot {
+    pub(super) width: u32,
+    pub(super) height: u32,
+    pub(super) render: Vec<u8>,
+    pub(super) target: Vec<u8>,
+    pub(super) marks: Marks,
 }
 
 impl<'a> MovedView<'a> {
@@ -97,6 +109,7 @@ impl<'a> MovedView<'a> {
             moved,
             frames,
             views: ViewCycle::default(),
+            centres: part_centres(&field.positions, parts, field.num_parts),
         })
     }
 
@@ -217,25 +230,32 @@ impl<'a> MovedView<'a> {
             .unwrap_or(0)
     }
 
-    /// The mesh moved by `motions`, rendered from view `view`, and that view's photo
-    /// (composited on the background): width, height and both as RGB8.
+    /// The mesh moved forward by `motions`, rendered from view `view`, beside that view's photo
+    /// (composited on the background), with each pixel's part and the moved parts' axes.
     pub(super) async fn snapshot(
         &mut self,
         ctx: &GpuContext,
         r: &MotionRenderer,
-        motions: &[(DMat3, DVec3)],
+        motions: &[PartMotion],
         view: usize,
-    ) -> GpuResult<(u32, u32, Vec<u8>, Vec<u8>)> {
-        self.render(ctx, r, motions, view).await?;
+    ) -> GpuResult<Snapshot> {
+        self.render(ctx, r, &forward_maps(motions), view).await?;
         let render = self.state.read_render(ctx).await?;
         let n = (render.width * render.height) as usize;
         let target = target_rgb(&self.frames[view], r.settings.background);
-        Ok((
-            render.width,
-            render.height,
-            planes_to_rgb8(&render.planes[..3 * n]),
-            planes_to_rgb8(&target),
-        ))
+        let camera = &self.frames[view].camera;
+        Ok(Snapshot {
+            width: render.width,
+            height: render.height,
+            render: planes_to_rgb8(&render.planes[..3 * n]),
+            target: planes_to_rgb8(&target),
+            marks: Marks {
+                parts: part_labels(&render),
+                axes: axis_marks(motions, &self.centres, |p| {
+                    camera.project(p.as_vec3()).map(|(px, _)| px.to_array())
+                }),
+            },
+        })
     }
 
     /// The bake-off's loss of the mesh moved by `motions` on the pixels labelled `part` in
@@ -272,4 +292,71 @@ impl<'a> MovedView<'a> {
         }
         Ok((sum, pixels))
     }
+}
+
+/// Per part its centroid and size (1.5 × RMS distance of its vertices to it; 0 when empty).
+fn part_centres(positions: &[Vec3], parts: &[u32], k: usize) -> Vec<(DVec3, f64)> {
+    let mut sums = vec![(DVec3::ZERO, 0.0, 0usize); k];
+    for (x, &p) in positions.iter().zip(parts) {
+        if let Some(s) = sums.get_mut(p as usize) {
+            s.0 += x.as_dvec3();
+            s.1 += x.as_dvec3().length_squared();
+            s.2 += 1;
+        }
+    }
+    sums.into_iter()
+        .map(|(sum, sq, n)| {
+            let n = n.max(1) as f64;
+            let c = sum / n;
+            (c, 1.5 * (sq / n - c.length_squared()).max(0.0).sqrt())
+        })
+        .collect()
+}
+
+/// Each pixel's part: the largest part logit where the render is mostly opaque.
+fn part_labels(render: &RenderImages) -> Vec<u8> {
+    let alpha = render.plane(4);
+    (0..alpha.len())
+        .map(|i| {
+            if alpha[i] < 0.5 {
+                return Marks::EMPTY;
+            }
+            (0..render.num_parts.min(usize::from(Marks::EMPTY)))
+                .max_by(|&a, &b| render.plane(5 + a)[i].total_cmp(&render.plane(5 + b)[i]))
+                .map_or(Marks::EMPTY, |p| p as u8)
+        })
+        .collect()
+}
+
+/// The moved parts' axes through `project` (world → pixel; `None` behind the camera): a part
+/// that turns more than a quarter degree is drawn as a hinge, one that only moves as a slide.
+fn axis_marks(
+    motions: &[PartMotion],
+    centres: &[(DVec3, f64)],
+    project: impl Fn(DVec3) -> Option<[f32; 2]>,
+) -> Vec<AxisMark> {
+    let mut marks = Vec::new();
+    for (part, (m, &(centre, size))) in motions.iter().zip(centres).enumerate().skip(1) {
+        let (_, angle) = m.axis_and_magnitude(JointKind::Revolute);
+        let (direction, distance) = m.axis_and_magnitude(JointKind::Prismatic);
+        let (kind, from, to) = if angle > 0.25f64.to_radians() {
+            let j = m.joint(JointKind::Revolute, centre);
+            let (o, d) = (j.origin.as_dvec3(), j.direction.as_dvec3());
+            (JointKind::Revolute, o - d * size, o + d * size)
+        } else if distance > 1e-6 {
+            let length = distance.max(0.5 * size);
+            (JointKind::Prismatic, centre, centre + direction * length)
+        } else {
+            continue; // still: nothing to draw
+        };
+        if let (Some(from), Some(to)) = (project(from), project(to)) {
+            marks.push(AxisMark {
+                part,
+                kind,
+                from,
+                to,
+            });
+        }
+    }
+    marks
 }

@@ -12,7 +12,6 @@ use super::config::ArticulationConfig;
 use super::moved_view::{backward_maps, forward_maps};
 use super::results::ArticulationPoint;
 use super::run::Run;
-use super::show::show_moved;
 use crate::articulation::vertex_motion::{StateSurface, VertexMotionWeights, vertex_motion_loss};
 use crate::articulation::{MotionAdam, MotionMask, PartSums};
 use crate::fit::observer::{Observer, Phase, checkpoint};
@@ -133,7 +132,8 @@ pub(super) async fn refine(
             checkpoint(observer, &at).await?;
             if observer.wants_preview() {
                 let at = (Phase::Refine, step + 1);
-                show_moved(run, observer, motions, at, "refined joints").await?;
+                run.show_moved(observer, motions, at, "refined joints")
+                    .await?;
             }
             // Flat: the reported objective moved by less than the tolerance since the last report.
             let objective = f64::from(forward_loss)

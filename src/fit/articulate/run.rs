@@ -5,9 +5,10 @@
 use super::config::ArticulationConfig;
 use super::moved_view::{MotionRenderer, MovedView};
 use super::results::ArticulationPoint;
+use crate::articulation::PartMotion;
 use crate::data::State;
-use crate::fit::observer::{Phase, Progress};
-use crate::gpu::{GpuContext, now_seconds};
+use crate::fit::observer::{Observer, Phase, Preview, Progress};
+use crate::gpu::{GpuContext, GpuResult, now_seconds};
 use crate::rng::Rng;
 
 /// The steps of the photometric stages.
@@ -77,5 +78,36 @@ impl Run<'_> {
             faces: self.sizes.1,
             elapsed_s: now_seconds() - self.t0,
         }
+    }
+}
+
+impl Run<'_> {
+    /// Renders the start state's mesh moved by `motions` from the end-state view that sees the
+    /// first movable part most, and hands it to `observer` as a [`Preview`] (with its marks).
+    pub(super) async fn show_moved(
+        &mut self,
+        observer: &mut dyn Observer,
+        motions: &[PartMotion],
+        (phase, iteration): (Phase, u32),
+        moved_by: &'static str,
+    ) -> GpuResult<()> {
+        let view = self.forward.view_showing(1);
+        let shot = self
+            .forward
+            .snapshot(self.ctx, &self.renderer, motions, view)
+            .await?;
+        observer.preview(Preview {
+            state: State::End,
+            view,
+            iteration,
+            phase,
+            moved_by: Some(moved_by),
+            width: shot.width,
+            height: shot.height,
+            render: shot.render,
+            target: shot.target,
+            marks: shot.marks,
+        });
+        Ok(())
     }
 }

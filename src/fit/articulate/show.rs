@@ -1,44 +1,15 @@
-//! What the articulation shows a watching driver (the page): the start state's mesh moved by
-//! the current joints and rendered from an end-state view beside its photo — the forward
-//! pixel-wise motion consistency as a picture — and each part's bake-off, both candidates side
-//! by side. Nothing here changes the fit; a driver that does not ask costs nothing.
+//! What the articulation shows a watching driver (the page) besides the moved previews
+//! (`Run::show_moved`): the joint seeds it starts from and each part's bake-off, both
+//! candidates side by side with their evidence. Nothing here changes the fit; a driver that
+//! does not ask costs nothing.
 
 use super::candidates::Candidates;
 use super::measured::Measured;
-use super::moved_view::forward_maps;
 use super::run::Run;
 use crate::articulation::PartMotion;
-use crate::data::{JointKind, State};
-use crate::fit::observer::{BakeOffView, Observer, Phase, Preview};
+use crate::data::JointKind;
+use crate::fit::observer::{BakeOffView, Observer};
 use crate::gpu::GpuResult;
-
-/// Renders the start state's mesh moved by `motions` from the end-state view that sees the
-/// first movable part most, and hands it to `observer` as a [`Preview`].
-pub(super) async fn show_moved(
-    run: &mut Run<'_>,
-    observer: &mut dyn Observer,
-    motions: &[PartMotion],
-    (phase, iteration): (Phase, u32),
-    moved_by: &'static str,
-) -> GpuResult<()> {
-    let view = run.forward.view_showing(1);
-    let (width, height, render, target) = run
-        .forward
-        .snapshot(run.ctx, &run.renderer, &forward_maps(motions), view)
-        .await?;
-    observer.preview(Preview {
-        state: State::End,
-        view,
-        iteration,
-        phase,
-        moved_by: Some(moved_by),
-        width,
-        height,
-        render,
-        target,
-    });
-    Ok(())
-}
 
 /// The joint seeds per part: the reconstructions' seed of the type whose registration fits
 /// better (identity for the base and for a part without one). What the articulation starts
@@ -83,23 +54,22 @@ pub(super) async fn show_bake_off(
     let (ctx, renderer) = (run.ctx, &run.renderer);
     let revolute = only(candidates.revolute[part]);
     let prismatic = only(candidates.prismatic[part]);
-    let (width, height, rot, target) = run
+    let rot = run.forward.snapshot(ctx, renderer, &revolute, view).await?;
+    let trans = run
         .forward
-        .snapshot(ctx, renderer, &forward_maps(&revolute), view)
-        .await?;
-    let (_, _, trans, _) = run
-        .forward
-        .snapshot(ctx, renderer, &forward_maps(&prismatic), view)
+        .snapshot(ctx, renderer, &prismatic, view)
         .await?;
     let g = measured.joints[part].as_ref();
     observer.bake_off(BakeOffView {
         part,
         view,
-        width,
-        height,
-        revolute: rot,
-        prismatic: trans,
-        target,
+        width: rot.width,
+        height: rot.height,
+        revolute: rot.render,
+        prismatic: trans.render,
+        target: rot.target,
+        revolute_marks: rot.marks,
+        prismatic_marks: trans.marks,
         revolute_loss: verdict.losses.0,
         prismatic_loss: verdict.losses.1,
         revolute_residual: g.map(|g| g.revolute_residual),

@@ -194,6 +194,7 @@ impl<'a> Trainer<'a> {
             height: render.height,
             render: planes_to_rgb8(&render.planes[..3 * n]),
             target: planes_to_rgb8(&target_rgb(frame, settings.background)),
+            marks: Default::default(),
         })
     }
 
