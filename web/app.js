@@ -251,6 +251,33 @@ async function runDemo() {
   }
 }
 
+/** Photographs the object in the zipped URDF `bytes` (named `name`) in both states on the GPU, as
+ *  the demo does for the fit form's preset; resolves to its Dataset. Throws, for input.js to show
+ *  inline, when there is no GPU or it is busy, and with the importer's or the capture's error. */
+async function captureObject(name, bytes, onProgress) {
+  if (!gpuOk || broken) {
+    throw new Error(`${name} holds a URDF, which is photographed on the GPU: ` +
+      (broken ? "reload the page first" : "this browser gives the page no WebGPU"));
+  }
+  if (busy) throw new Error(`${name}: the GPU is busy with a self-test, demo or fit; drop the .zip again when it is done`);
+  const preset = $("fit-preset").value;
+  let budget;
+  try {
+    budget = budgetOverrides(preset);
+  } catch (e) {
+    throw new Error(`check the budgets (Advanced: budgets): ${errorText(e)}`);
+  }
+  busy = true;
+  updateButtons();
+  hideBanner();
+  try {
+    return await wasm.Dataset.from_object_zip(name, bytes, preset, 0, onProgress, budget);
+  } finally {
+    busy = false;
+    updateButtons();
+  }
+}
+
 // --- 3. + 4. fit and result ---------------------------------------------------------------
 
 /** Fits `ds` with `preset` and `budget` (the budgets' overrides as JSON, or undefined). */
@@ -330,6 +357,7 @@ async function main() {
         currentDataset = null;
         updateButtons();
       },
+      captureObject,
     });
     wireFitButtons();
     wireResultButtons();

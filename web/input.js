@@ -1,11 +1,13 @@
 // The Input section's dataset half: reads a dropped or picked folder or .zip into a wasm Dataset
 // (of a folder only the files the dataset needs; a folder or .zip past the page's budgets is
-// refused before it is read), shows its summary and thumbnails, or the readers' problems.
+// refused before it is read), shows its summary and thumbnails, or the readers' problems. A .zip
+// of a URDF with its meshes is an object: the page photographs it on the GPU (app.js's
+// captureObject) and it becomes a dataset like any other.
 // `document.body.dataset.dataset` becomes "ok" or "problems" (tests wait on it).
 import { $, errorText, drawRgba, freeQuietly } from "./util.js";
 
 let Dataset = null;
-let hooks = { onDataset: () => {}, onProblems: () => {} };
+let hooks = { onDataset: () => {}, onProblems: () => {}, captureObject: null };
 let loadToken = 0;
 // The page's budgets (Dataset.file_limits()); set in setupInput.
 let limits = { max_listed_files: Infinity, max_zip_bytes: Infinity };
@@ -44,13 +46,13 @@ function status(text) {
   out.textContent = text;
 }
 
-function problems(message) {
+function problems(message, what = "dataset") {
   // The message counts its problems itself (and lists at most 50 of them).
   const lines = message.split("\n").filter((l) => l.trim() !== "");
   const out = $("dataset-result");
   out.hidden = false;
   out.className = "fail";
-  out.textContent = "The dataset cannot be used: " + lines.join("\n");
+  out.textContent = `The ${what} cannot be used: ` + lines.join("\n");
   $("thumbs").hidden = true;
   $("fit-controls").hidden = true;
   document.body.dataset.dataset = "problems";
@@ -149,6 +151,9 @@ async function loadZip(file) {
   status(`Reading ${file.name}…`);
   const bytes = new Uint8Array(await file.arrayBuffer());
   if (token !== loadToken) return;
+  let object = false;
+  try { object = Dataset.zip_holds_object(bytes); } catch { /* from_zip says what is wrong */ }
+  if (object) return loadObject(file.name, bytes, token);
   status(`Checking ${file.name}…`);
   let ds;
   try {
@@ -158,6 +163,27 @@ async function loadZip(file) {
     return;
   }
   if (token !== loadToken) { freeQuietly(ds); return; }
+  hooks.onDataset(ds);
+}
+
+// A .zip holding a URDF: imported and photographed in both states on the GPU, it then shows
+// as a dataset (the truth comes with it, so its fit is scored).
+async function loadObject(name, bytes, token) {
+  status(`${name} holds a URDF: importing it and photographing both states on the GPU…`);
+  $("thumbs").hidden = true;
+  $("fit-controls").hidden = true;
+  const t0 = performance.now();
+  let ds;
+  try {
+    ds = await hooks.captureObject(name, bytes, (p) => {
+      if (token === loadToken && p?.total > 0) status(`Photographing ${name}: ${p.done} of ${p.total} views rendered…`);
+    });
+  } catch (e) {
+    if (token === loadToken) problems(errorText(e), "object");
+    return;
+  }
+  if (token !== loadToken) { freeQuietly(ds); return; }
+  document.body.dataset.captureSeconds = ((performance.now() - t0) / 1000).toFixed(2);
   hooks.onDataset(ds);
 }
 
@@ -177,10 +203,11 @@ async function loadDropped(entries, files) {
   }
 }
 
-/** Wires the drop zone and both pickers. `onDataset(ds)` gets each validated Dataset. */
-export function setupInput(DatasetClass, { onDataset, onProblems }) {
+/** Wires the drop zone and both pickers. `onDataset(ds)` gets each validated Dataset;
+ *  `captureObject(name, bytes, onProgress)` photographs a zipped URDF into one (a Promise). */
+export function setupInput(DatasetClass, { onDataset, onProblems, captureObject }) {
   Dataset = DatasetClass;
-  hooks = { onDataset, onProblems };
+  hooks = { onDataset, onProblems, captureObject };
   limits = JSON.parse(Dataset.file_limits());
   const zone = $("dropzone");
   for (const type of ["dragenter", "dragover"]) {

@@ -207,6 +207,31 @@ pub fn dataset_paths(given: impl IntoIterator<Item = String>) -> BTreeMap<String
         .collect()
 }
 
+/// A zip archive read from memory.
+pub(super) type MemoryZip<'a> = ::zip::ZipArchive<Cursor<&'a [u8]>>;
+
+/// The files of `archive` (named `name` in errors) by normalised path → (entry index, size by
+/// its header); folder entries and macOS `__MACOSX/` resource forks are skipped. An entry whose
+/// path is absolute or leaves the archive is an error, as is an unreadable one (`not_zip`).
+pub(super) fn zip_entries(
+    name: &str,
+    archive: &mut MemoryZip,
+    not_zip: &dyn Fn(::zip::result::ZipError) -> DataError,
+) -> Result<BTreeMap<String, (usize, u64)>, DataError> {
+    let mut entries = BTreeMap::new();
+    for i in 0..archive.len() {
+        let entry = archive.by_index_data(i).map_err(not_zip)?;
+        let raw = entry.name().map_err(not_zip)?;
+        if entry.is_dir() || raw.starts_with("__MACOSX/") {
+            continue;
+        }
+        let path = normalize(&raw)
+            .map_err(|e| DataError::field(name, format!("entry {i}"), e.to_string()))?;
+        entries.insert(path, (i, entry.size()));
+    }
+    Ok(entries)
+}
+
 /// The dataset's files in the zip archive `bytes` (named `name` in errors), re-rooted at the
 /// dataset folder inside it, within the default [`FileLimits`]: see [`read_zip_within`].
 pub fn read_zip(name: &str, bytes: &[u8]) -> Result<FileSet, DataError> {
@@ -232,18 +257,7 @@ pub fn read_zip_within(
     };
     let mut archive = ::zip::ZipArchive::new(Cursor::new(bytes)).map_err(not_zip)?;
     limits.check_listed(name, archive.len())?;
-    // Entry path → (index, size by its header).
-    let mut entries = BTreeMap::new();
-    for i in 0..archive.len() {
-        let entry = archive.by_index_data(i).map_err(not_zip)?;
-        let raw = entry.name().map_err(not_zip)?;
-        if entry.is_dir() || raw.starts_with("__MACOSX/") {
-            continue;
-        }
-        let path = normalize(&raw)
-            .map_err(|e| DataError::field(name, format!("entry {i}"), e.to_string()))?;
-        entries.insert(path, (i, entry.size()));
-    }
+    let entries = zip_entries(name, &mut archive, &not_zip)?;
     if entries.is_empty() {
         return Err(DataError::file(
             name,

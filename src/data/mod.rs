@@ -31,6 +31,7 @@ mod json;
 #[cfg(not(target_arch = "wasm32"))]
 mod lazy_folder;
 mod npy;
+mod object_archive;
 pub(crate) mod parallel;
 mod paths;
 mod ply;
@@ -53,6 +54,7 @@ pub use image_io::{DepthMap, PartMap, PngPixels, RgbaImage, encode_png, png_clai
 #[cfg(not(target_arch = "wasm32"))]
 pub use lazy_folder::LazyFolder;
 pub use npy::encode_npy;
+pub use object_archive::{is_urdf_path, read_zip_object, zip_holds_object};
 pub use paths::rebase_on_dataset_root;
 pub use ply::{PlyFormat, TriMesh};
 pub use summary::{Summary, ViewSummary};

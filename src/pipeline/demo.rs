@@ -5,7 +5,7 @@ use super::{FitInput, PipelineError};
 use crate::fit::object::FitConfig;
 use crate::gpu::GpuContext;
 use crate::object::ArticulatedObject;
-use crate::render::{RenderProgress, RenderSpec, capture_dataset};
+use crate::render::{CaptureError, RenderProgress, RenderSpec, capture_dataset};
 use crate::synth::{Category, SynthParams, generate};
 
 // The demo's capture follows the fit's budget but is no part of fitting: it lives here, as
@@ -62,12 +62,25 @@ pub async fn capture_demo(
     spec: &RenderSpec,
     on_view: &mut dyn FnMut(RenderProgress),
 ) -> Result<FitInput, PipelineError> {
-    let dataset = capture_dataset(ctx, object, spec, on_view)
+    capture_object(ctx, object, category.name(), spec, on_view)
         .await
-        .map_err(|e| PipelineError::Demo(format!("{}: {e}", object.name)))?;
+        .map_err(|e| PipelineError::Demo(format!("{}: {e}", object.name)))
+}
+
+/// Captures `object` in both states as `spec` says, its ground truth (joints, part meshes)
+/// included so the fit is scored; the dataset is named after the object and labelled `category`
+/// in the metrics. The demo's objects and a user's zipped URDF ([`super::object`]) both come here.
+pub async fn capture_object(
+    ctx: &GpuContext,
+    object: &ArticulatedObject,
+    category: &str,
+    spec: &RenderSpec,
+    on_view: &mut dyn FnMut(RenderProgress),
+) -> Result<FitInput, CaptureError> {
+    let dataset = capture_dataset(ctx, object, spec, on_view).await?;
     Ok(FitInput {
         dataset,
         id: object.name.clone(),
-        category: category.name().into(),
+        category: category.into(),
     })
 }

@@ -6,6 +6,7 @@
 
 pub mod check;
 pub mod demo;
+pub mod object;
 pub mod preview;
 
 use std::fmt;
@@ -26,6 +27,9 @@ pub enum PipelineError {
     Dataset(String),
     /// The demo's object could not be made or captured; the message names it when known.
     Demo(String),
+    /// A user's object (a zipped URDF) could not be read, imported or captured; the message
+    /// names the archive and the file at fault.
+    Object(String),
     /// The fit of object `id` stopped: a GPU failure, or the observer cancelled it.
     Fit { id: String, source: GpuError },
     /// Scoring or exporting the fit failed; the message names the object and the step.
@@ -37,7 +41,7 @@ pub enum PipelineError {
 impl fmt::Display for PipelineError {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         match self {
-            Self::Dataset(m) | Self::Demo(m) | Self::Export(m) => f.write_str(m),
+            Self::Dataset(m) | Self::Demo(m) | Self::Object(m) | Self::Export(m) => f.write_str(m),
             Self::Fit { id, source } => write!(f, "{id}: {source}"),
             Self::Write(e) => write!(f, "{e}"),
         }

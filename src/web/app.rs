@@ -15,13 +15,14 @@ use crate::fit::observer::{BakeOffView, Command, Marks, Observer, Preview, Progr
 use crate::gpu::now_seconds;
 use crate::pipeline::preview::PREVIEW_FILE;
 use crate::pipeline::{self, FitInput, PipelineError};
+use crate::render::RenderProgress;
 use crate::synth::Category;
 
 /// Seconds between two previews the page is sent.
 const PREVIEW_EVERY_S: f64 = 1.5;
 
 /// A plain JS object from key/value pairs.
-fn js_object(pairs: &[(&str, JsValue)]) -> JsValue {
+pub(super) fn js_object(pairs: &[(&str, JsValue)]) -> JsValue {
     let o = Object::new();
     for (k, v) in pairs {
         let _ = Reflect::set(&o, &JsValue::from_str(k), v);
@@ -29,7 +30,7 @@ fn js_object(pairs: &[(&str, JsValue)]) -> JsValue {
     o.into()
 }
 
-fn number(v: impl Into<f64>) -> JsValue {
+pub(super) fn number(v: impl Into<f64>) -> JsValue {
     JsValue::from_f64(v.into())
 }
 
@@ -116,9 +117,20 @@ pub fn catalogue() -> String {
     .to_string()
 }
 
+/// A capture's progress for `on_progress`: `{done, total}` views.
+pub(super) fn view_progress(on_progress: &Function) -> impl FnMut(RenderProgress) + '_ {
+    move |p| {
+        let ev = js_object(&[
+            ("done", number(p.done as u32)),
+            ("total", number(p.total as u32)),
+        ]);
+        let _ = on_progress.call1(&JsValue::NULL, &ev);
+    }
+}
+
 /// A validated dataset held in wasm memory, with the names its fit carries.
 #[wasm_bindgen(js_name = Dataset)]
-pub struct WebDataset(Rc<FitInput>);
+pub struct WebDataset(pub(super) Rc<FitInput>);
 
 fn dataset_from(files: &FileSet, name: String) -> Result<WebDataset, JsError> {
     let input = pipeline::dataset_from_files(files, name, &Default::default())
@@ -164,15 +176,10 @@ impl WebDataset {
             pipeline::demo::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
         let ctx = context().await?;
         let spec = config.demo_capture(seed.into());
-        let input = pipeline::demo::capture_demo(&ctx, &object, category, &spec, &mut |p| {
-            let ev = js_object(&[
-                ("done", number(p.done as u32)),
-                ("total", number(p.total as u32)),
-            ]);
-            let _ = on_progress.call1(&JsValue::NULL, &ev);
-        })
-        .await
-        .map_err(js_error)?;
+        let mut on_view = view_progress(&on_progress);
+        let input = pipeline::demo::capture_demo(&ctx, &object, category, &spec, &mut on_view)
+            .await
+            .map_err(js_error)?;
         Ok(WebDataset(Rc::new(input)))
     }
 

@@ -13,6 +13,7 @@
 pub mod app;
 mod budget;
 mod files;
+mod object;
 pub mod viewer;
 
 use std::cell::RefCell;

@@ -17,6 +17,7 @@ import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
+import { checkUrdfZip } from "./urdf.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
 // the browser) asserts the issue's 0.5° / 5 mm (docs/results.md, "Browser vs native").
@@ -518,6 +519,7 @@ try {
       `after the bomb, a dataset beside a 4 GB file loads reading ${read.length} files, not the 4 GB one`);
   });
 
+  await step("zipped URDF", () => checkUrdfZip({ page, check, native, work }));
   // 7. nothing leaves the page -------------------------------------------------------------
   await step("offline", async () => {
     const foreign = requests.filter((r) => /^https?:/i.test(r) && !r.startsWith(url));

@@ -34,8 +34,16 @@ pub(super) fn read_urdf(
         .ok_or_else(|| DataError::file(urdf_path, "URDF file not found in the dataset"))?;
     let text = std::str::from_utf8(bytes)
         .map_err(|e| DataError::file(urdf_path, format!("URDF is not valid UTF-8: {e}")))?;
-    let doc = roxmltree::Document::parse(text)
-        .map_err(|e| DataError::file(urdf_path, format!("URDF is not well-formed XML: {e}")))?;
+    let doc = roxmltree::Document::parse(text).map_err(|e| {
+        let at = e.pos();
+        DataError::file(
+            urdf_path,
+            format!(
+                "URDF is not well-formed XML at line {}, column {} ({e}): expected an XML document whose root element is <robot>",
+                at.row, at.col
+            ),
+        )
+    })?;
     let robot = doc.root_element();
     let mut cx = Reader {
         file: urdf_path,
