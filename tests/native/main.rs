@@ -31,3 +31,4 @@ mod reconstruct;
 mod render_gt;
 mod synth_objects;
 mod urdf_folder;
+mod viewer_opening;
