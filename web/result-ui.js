@@ -1,5 +1,6 @@
-// The Result section: the WebGPU viewer of the twin (orbit, zoom, a slider per joint), the
-// metrics and joints tables, the report's warnings and the downloads.
+// The Result section: the WebGPU viewer of the twin (orbit, zoom, a slider per joint, a play
+// button animating every joint between its states, the part-colour legend, the true parts laid
+// over the fit), the metrics and joints tables, the report's warnings and the downloads.
 // Sets `document.body.dataset.result = "ready"` and `document.body.dataset.jointCount`.
 import { $, errorText, fmtNum, freeQuietly } from "./util.js";
 
@@ -11,6 +12,7 @@ let drawPending = false;
 
 /** Forgets the shown result (before a new fit starts). */
 export function clearResult() {
+  stopPlaying();
   delete document.body.dataset.result;
   delete document.body.dataset.jointCount;
   resizeObserver?.disconnect();
@@ -110,6 +112,81 @@ function wireCamera(el) {
   });
 }
 
+// --- play ---------------------------------------------------------------------------------
+
+/** One start → end → start cycle of the play button (ms): slow enough to follow a part. */
+const PLAY_PERIOD_MS = 4000;
+let playing = false;
+let playFrame = 0;
+/** Where in the cycle (ms) the motion was paused, so play resumes from there. */
+let playElapsed = 0;
+let playOrigin = 0;
+
+function setPlayButton(on) {
+  $("play").setAttribute("aria-pressed", String(on));
+}
+
+function playTick(now) {
+  if (!playing || !viewer) return;
+  playElapsed = now - playOrigin;
+  // Eased both ways (a cosine), so each state is held a moment and the turn is gentle.
+  const t = (1 - Math.cos((2 * Math.PI * playElapsed) / PLAY_PERIOD_MS)) / 2;
+  try { viewer.set_phase(t); } catch (e) { console.error("set_phase:", e); stopPlaying(); return; }
+  syncSliders(sliders);
+  requestDraw();
+  playFrame = requestAnimationFrame(playTick);
+}
+
+function startPlaying() {
+  if (playing || !viewer) return;
+  playing = true;
+  setPlayButton(true);
+  playOrigin = performance.now() - playElapsed;
+  playFrame = requestAnimationFrame(playTick);
+}
+
+/** Pauses the motion; `reset` (a slider moved, a state picked) starts the next play afresh. */
+function stopPlaying(reset = true) {
+  playing = false;
+  cancelAnimationFrame(playFrame);
+  if (reset) playElapsed = 0;
+  if ($("play")) setPlayButton(false);
+}
+
+/** Plays on its own only where motion is welcome and cheap: not for a visitor who asked for
+ * reduced motion, nor on a software adapter, where every frame costs a second of CPU. */
+function autoplayWanted() {
+  const reduced = window.matchMedia?.("(prefers-reduced-motion: reduce)").matches ?? false;
+  return !reduced && document.body.dataset.software !== "true";
+}
+
+// --- legend -------------------------------------------------------------------------------
+
+/** The part-colour legend from the viewer (its colours are the renderer's palette). */
+function buildLegend() {
+  const list = $("part-legend");
+  list.replaceChildren();
+  let entries = [];
+  try { entries = JSON.parse(viewer.legend()); } catch (e) { console.error("legend:", e); }
+  for (const e of entries) {
+    const li = document.createElement("li");
+    li.dataset.part = String(e.part);
+    li.dataset.colour = e.colour;
+    li.title = e.link ? `link ${e.link}` : "";
+    const swatch = document.createElement("span");
+    swatch.className = "swatch";
+    swatch.style.backgroundColor = e.colour;
+    swatch.setAttribute("aria-hidden", "true");
+    li.append(swatch, document.createTextNode(e.name));
+    list.append(li);
+  }
+  showLegend();
+}
+
+function showLegend() {
+  $("part-legend").hidden = !$("colour-by-part").checked || $("part-legend").childElementCount === 0;
+}
+
 // --- sliders ------------------------------------------------------------------------------
 
 function fmtValue(v, unit) {
@@ -141,6 +218,7 @@ function buildSliders(joints) {
     const setLabel = (v) => { label.textContent = `${name}: ${fmtValue(v, j.unit)}`; };
     setLabel(input.value);
     input.addEventListener("input", () => {
+      stopPlaying();
       const v = Number(input.value);
       setLabel(v);
       if (!viewer) return;
@@ -318,6 +396,7 @@ let sliders = [];
 export function wireResultButtons() {
   for (const state of ["start", "end"]) {
     $(`state-${state}`).addEventListener("click", () => {
+      stopPlaying();
       if (!viewer) return;
       try { viewer.set_state(state); } catch (e) { console.error("set_state:", e); }
       syncSliders(sliders);
@@ -326,9 +405,18 @@ export function wireResultButtons() {
   }
   window.addEventListener("resize", () => resize());
   for (const [id, [name, type]] of Object.entries(DOWNLOADS)) $(id).addEventListener("click", () => download(name, type));
+  $("play").addEventListener("click", () => {
+    if (playing) stopPlaying(false); else startPlaying();
+  });
   $("colour-by-part").addEventListener("change", (e) => {
+    showLegend();
     if (!viewer) return;
     try { viewer.colour_by_part(e.target.checked); } catch (err) { console.error(err); }
+    requestDraw();
+  });
+  $("show-truth-parts").addEventListener("change", (e) => {
+    if (!viewer) return;
+    try { viewer.show_truth_parts(e.target.checked); } catch (err) { console.error(err); }
     requestDraw();
   });
   $("show-truth").addEventListener("change", (e) => {
@@ -390,7 +478,15 @@ export async function showResult(ViewerClass, fitResult) {
     const truth = viewer.has_truth();
     $("show-truth-label").hidden = !truth;
     viewer.show_truth(truth && $("show-truth").checked);
+    const parts = viewer.has_truth_parts();
+    $("show-truth-parts-label").hidden = !parts;
+    viewer.show_truth_parts(parts && $("show-truth-parts").checked);
+    const view = JSON.parse(viewer.opening_view());
+    canvas.dataset.openingScore = String(view.score);
+    canvas.dataset.openingOldScore = String(view.old_score);
+    canvas.dataset.openingMs = String(view.ms);
   } catch (e) { console.error(e); }
+  buildLegend();
   delete canvas.dataset.sized;
   resize();
   resizeObserver = new ResizeObserver(() => resize());
@@ -398,5 +494,7 @@ export async function showResult(ViewerClass, fitResult) {
   flushDraw();
   document.body.dataset.jointCount = String(vj.length);
   document.body.dataset.result = "ready";
+  playElapsed = 0;
+  if (autoplayWanted() && vj.length > 0) startPlaying();
   return { report, joints };
 }

@@ -31,6 +31,9 @@ pub struct FitFolder {
     pub twin: Twin,
     /// The dataset's true joints, when it has them (the page draws their axes).
     pub truth: Option<Vec<crate::data::GtJoint>>,
+    /// The dataset's true part meshes at the start state, when it has them (the page's viewer
+    /// draws them over the fitted twin).
+    pub truth_meshes: Option<crate::data::GtMeshes>,
 }
 
 /// Which step of [`FitFolder::build`] failed, for which object (`id`) or file (`what`).
@@ -162,6 +165,7 @@ impl FitFolder {
             files,
             twin,
             truth: dataset.gt_joints.clone(),
+            truth_meshes: dataset.gt_meshes[0].clone(),
         })
     }
 }

@@ -1,30 +1,20 @@
 //! The result viewer's scene, independent of where it is drawn: an articulated object at
 //! adjustable joint values, coloured by its own colours or by part, with each joint's axis as a
-//! thin rod, seen by an orbiting camera. The page draws it on a WebGPU canvas
-//! ([`super::GtRenderer::draw`]); tests render it off-screen.
+//! thin rod, seen by an orbiting camera; when the truth is known, the true parts as a ghost
+//! ([`ghost_over`]) articulated along with the fitted ones. The page draws it on a WebGPU canvas
+//! ([`super::GtRenderer::render_view`]); tests render it off-screen.
+
+mod opening;
+pub mod palette;
 
 use glam::{Affine3A, Quat, Vec3};
 
-use super::{PartMesh, object_bounds, posed_part_meshes};
-use crate::data::{Camera, look_at};
+use super::{PartMesh, RenderedView, object_bounds, posed_part_meshes};
+use crate::data::{Camera, RgbaImage, look_at};
 use crate::object::{ArticulatedObject, JointKind, Material, box_mesh};
+pub use opening::{Coverage, OLD_DEFAULT, OpeningView, SCORE_SIZE, coverage, view_score};
+use palette::{PRISMATIC_ROD, REVOLUTE_ROD, TRUTH_PART, TRUTH_ROD, part_colour, part_css};
 
-/// Part colours when colouring by part (linear RGB; part 0, the base, is grey).
-const PALETTE: [[f32; 3]; 8] = [
-    [0.55, 0.55, 0.55],
-    [0.85, 0.25, 0.15],
-    [0.15, 0.45, 0.85],
-    [0.20, 0.65, 0.25],
-    [0.85, 0.65, 0.10],
-    [0.55, 0.25, 0.75],
-    [0.10, 0.65, 0.70],
-    [0.85, 0.40, 0.60],
-];
-/// Axis rod colours: revolute orange, prismatic blue.
-const REVOLUTE_ROD: [f32; 3] = [1.0, 0.45, 0.0];
-const PRISMATIC_ROD: [f32; 3] = [0.0, 0.35, 1.0];
-/// The true axes' colour, when the truth is known: near black, apart from the fitted ones.
-pub const TRUTH_ROD: [f32; 3] = [0.05, 0.05, 0.05];
 /// Vertical field of view of the viewer's camera (radians).
 const FOV_Y: f32 = 0.7;
 
@@ -70,6 +60,9 @@ pub struct TwinScene {
     /// part hangs from the base), drawn in [`TRUTH_ROD`] while `show_truth` is on.
     pub truth_axes: Vec<(Vec3, Vec3)>,
     pub show_truth: bool,
+    /// The true object, when known, drawn as a ghost while `show_truth_parts` is on.
+    truth: Option<TruthParts>,
+    pub show_truth_parts: bool,
     centre: Vec3,
     radius: f32,
     /// Camera azimuth and elevation (radians) and distance as a multiple of the framing distance.
@@ -126,10 +119,12 @@ impl TwinScene {
             show_axes: true,
             truth_axes: Vec::new(),
             show_truth: true,
+            truth: None,
+            show_truth_parts: false,
             centre: (lo + hi) * 0.5,
             radius: ((hi - lo).length() * 0.5).max(1e-3),
-            yaw: -1.05,
-            pitch: 0.45,
+            yaw: OLD_DEFAULT.0,
+            pitch: OLD_DEFAULT.1,
             zoom: 1.0,
         }
     }
@@ -157,13 +152,130 @@ impl TwinScene {
             return false;
         }
         let (lo, hi) = (j.lower.min(j.upper), j.lower.max(j.upper));
-        self.values[j.index] = value.clamp(lo, hi) / j.scale();
+        let index = j.index;
+        self.values[index] = value.clamp(lo, hi) / j.scale();
+        if let Some(truth) = &mut self.truth {
+            truth.follow(index, self.values[index]);
+        }
         true
     }
 
-    /// Puts every joint at the start (`false`) or end (`true`) state.
+    /// Puts every joint at the start (`false`) or end (`true`) state, the true parts too.
     pub fn set_state(&mut self, end: bool) {
-        self.values = if end { &self.end } else { &self.start }.clone();
+        self.set_phase(if end { 1.0 } else { 0.0 });
+    }
+
+    /// Puts every joint `t` of the way from the start state (0) to the end state (1), the true
+    /// parts too (each along its own motion): what the play button animates.
+    pub fn set_phase(&mut self, t: f32) {
+        let t = if t.is_finite() { t } else { 0.0 };
+        let lerp = |a: &[f32], b: &[f32]| a.iter().zip(b).map(|(a, b)| a + (b - a) * t).collect();
+        self.values = lerp(&self.start, &self.end);
+        if let Some(truth) = &mut self.truth {
+            truth.values = lerp(&truth.start, &truth.end);
+        }
+    }
+
+    /// Adds the true object, `end` its end state's joint values (start: all 0). `pairs` says
+    /// which true joint each fitted joint is (indices into the two objects' joints): those
+    /// follow the sliders — at the same value when the kinds agree (turned to the fitted axis's
+    /// sense), else at the same share of their motion; the others move with the state buttons
+    /// and the play button only.
+    pub fn set_truth(
+        &mut self,
+        object: ArticulatedObject,
+        end: Vec<f32>,
+        pairs: &[(usize, usize)],
+    ) {
+        let mut end = end;
+        end.resize(object.joints.len(), 0.0);
+        let mut follow = vec![None; self.object.joints.len()];
+        for &(fitted, truth) in pairs {
+            let (Some(f), Some(t)) = (self.object.joints.get(fitted), object.joints.get(truth))
+            else {
+                continue;
+            };
+            let gain = if f.kind == t.kind {
+                // An axis and its opposite with the opposite motion are the same joint.
+                if f.axis.dot(t.axis) < 0.0 { -1.0 } else { 1.0 }
+            } else if self.end[fitted] != 0.0 {
+                end[truth] / self.end[fitted]
+            } else {
+                0.0
+            };
+            follow[fitted] = Some((truth, gain));
+        }
+        let start = vec![0.0; object.joints.len()];
+        let mut truth = TruthParts {
+            object,
+            values: start.clone(),
+            start,
+            end,
+            follow,
+        };
+        for (i, &v) in self.values.iter().enumerate() {
+            truth.follow(i, v);
+        }
+        self.truth = Some(truth);
+    }
+
+    /// Whether the true parts are known.
+    pub fn has_truth_parts(&self) -> bool {
+        self.truth.is_some()
+    }
+
+    /// The legend of "Colour by part": one entry per part of the fitted object.
+    pub fn legend(&self) -> Vec<LegendEntry> {
+        let parts = self.object.parts();
+        parts
+            .parts
+            .iter()
+            .enumerate()
+            .map(|(k, part)| {
+                let link = part
+                    .links
+                    .first()
+                    .and_then(|&l| self.object.links.get(l))
+                    .map_or_else(String::new, |l| l.name.clone());
+                let joint = part.joint.and_then(|j| self.object.joints.get(j));
+                let kind = joint.map(|j| match j.kind {
+                    JointKind::Prismatic => "slide",
+                    JointKind::Fixed => "fixed",
+                    JointKind::Revolute | JointKind::Continuous => "hinge",
+                });
+                // "part_2" reads as "part 2", the joints table's numbering.
+                let shown = link.replace('_', " ");
+                let name = match kind {
+                    None if k == 0 => "base".to_string(),
+                    None => shown,
+                    Some(kind) => format!("{shown} ({kind})"),
+                };
+                LegendEntry {
+                    part: k,
+                    name,
+                    link,
+                    colour: part_css(k),
+                }
+            })
+            .collect()
+    }
+
+    /// The camera's yaw and pitch (radians).
+    pub fn view(&self) -> (f32, f32) {
+        (self.yaw, self.pitch)
+    }
+
+    /// Chooses the opening view (see [`opening`]): the orbit view from which the movable parts
+    /// show best at both states; turns the camera there and returns the choice.
+    pub fn choose_opening_view(&mut self) -> OpeningView {
+        let states = [&self.start, &self.end].map(|q| posed_part_meshes(&self.object, q));
+        let parts = self.object.parts().parts.len();
+        let (w, h) = SCORE_SIZE;
+        let choice = opening::choose(&states, parts, |yaw, pitch| {
+            self.camera_at(yaw, pitch, self.zoom, w, h)
+        });
+        (self.yaw, self.pitch) = (choice.yaw, choice.pitch);
+        choice
     }
 
     /// Turns the camera by `dx`, `dy` pixels of a drag (a full canvas width is about half a turn).
@@ -183,14 +295,19 @@ impl TwinScene {
 
     /// The camera for a `width` × `height` image.
     pub fn camera(&self, width: u32, height: u32) -> Camera {
+        self.camera_at(self.yaw, self.pitch, self.zoom, width, height)
+    }
+
+    /// The camera at `yaw`, `pitch` and `zoom` for a `width` × `height` image.
+    fn camera_at(&self, yaw: f32, pitch: f32, zoom: f32, width: u32, height: u32) -> Camera {
         let direction = Vec3::new(
-            self.pitch.cos() * self.yaw.cos(),
-            self.pitch.cos() * self.yaw.sin(),
-            self.pitch.sin(),
+            pitch.cos() * yaw.cos(),
+            pitch.cos() * yaw.sin(),
+            pitch.sin(),
         );
         let aspect = width.max(1) as f32 / height.max(1) as f32;
         let half = (FOV_Y * 0.5).tan() * aspect.min(1.0);
-        let distance = self.radius / half.atan().sin() * 1.1 * self.zoom;
+        let distance = self.radius / half.atan().sin() * 1.1 * zoom;
         let pose = look_at(self.centre + direction * distance, self.centre, Vec3::Z);
         let fov_x = 2.0 * ((FOV_Y * 0.5).tan() * aspect).atan();
         Camera::from_fov(pose, width.max(1), height.max(1), fov_x, None)
@@ -201,7 +318,7 @@ impl TwinScene {
         let mut meshes = posed_part_meshes(&self.object, &self.values);
         if self.colour_by_part {
             for m in &mut meshes {
-                let c = PALETTE[m.part.max(0) as usize % PALETTE.len()];
+                let c = part_colour(m.part.max(0) as usize);
                 m.mesh.colors = Some(vec![c; m.mesh.positions.len()]);
                 m.mesh.material.texture = None;
             }
@@ -229,6 +346,20 @@ impl TwinScene {
         meshes
     }
 
+    /// The true parts to draw as a ghost over [`TwinScene::meshes`] ([`ghost_over`]): empty
+    /// unless the truth is known and `show_truth_parts` is on.
+    pub fn truth_meshes(&self) -> Vec<PartMesh> {
+        let Some(truth) = self.truth.as_ref().filter(|_| self.show_truth_parts) else {
+            return Vec::new();
+        };
+        let mut meshes = posed_part_meshes(&truth.object, &truth.values);
+        for m in &mut meshes {
+            m.mesh.colors = Some(vec![TRUTH_PART; m.mesh.positions.len()]);
+            m.mesh.material.texture = None;
+        }
+        meshes
+    }
+
     /// A thin rod of `color` through `at` along unit `axis`, a little longer than the object.
     fn rod(&self, at: Vec3, axis: Vec3, color: [f32; 3]) -> PartMesh {
         let rod = self.radius * 1.1;
@@ -245,119 +376,97 @@ impl TwinScene {
     }
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-    use crate::data::{GtJoint, GtMeshes, JointKind as GtKind, TriMesh};
-    use crate::export::Twin;
+/// One entry of the part-colour legend.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct LegendEntry {
+    /// The part's id (0: the base), as the renderer's part map has it.
+    pub part: usize,
+    /// What the legend says, e.g. "base" or "part 1 (hinge)".
+    pub name: String,
+    /// The part's first link, e.g. "part_1", as the URDF names it.
+    pub link: String,
+    /// Its colour as CSS text (`#rrggbb`).
+    pub colour: String,
+}
 
-    fn cube(at: Vec3) -> TriMesh {
-        let m = box_mesh(Vec3::splat(0.2), Material::default());
-        TriMesh {
-            positions: m.positions.iter().map(|p| *p + at).collect(),
-            triangles: m.indices,
+/// The true object beside the fitted one, at its own joint values.
+#[derive(Debug, Clone)]
+struct TruthParts {
+    object: ArticulatedObject,
+    values: Vec<f32>,
+    start: Vec<f32>,
+    end: Vec<f32>,
+    /// Per fitted joint: the true joint that follows it and the gain from fitted to true value.
+    follow: Vec<Option<(usize, f32)>>,
+}
+
+impl TruthParts {
+    /// Moves the true joint paired with fitted joint `fitted`, now at `value`.
+    fn follow(&mut self, fitted: usize, value: f32) {
+        if let Some(&Some((truth, gain))) = self.follow.get(fitted)
+            && let Some(slot) = self.values.get_mut(truth)
+        {
+            *slot = gain * value;
         }
-    }
-
-    fn scene() -> TwinScene {
-        let start = GtMeshes {
-            static_part: cube(Vec3::ZERO),
-            movable: vec![
-                cube(Vec3::new(0.3, 0.0, 0.0)),
-                cube(Vec3::new(0.0, 0.3, 0.0)),
-            ],
-        };
-        let joints = [
-            GtJoint {
-                kind: GtKind::Revolute,
-                origin: Vec3::new(0.2, 0.0, 0.0),
-                direction: Vec3::Z,
-                start: 0.0,
-                end: 60.0,
-            },
-            GtJoint {
-                kind: GtKind::Prismatic,
-                origin: Vec3::new(0.0, 0.3, 0.0),
-                direction: Vec3::Y,
-                start: 0.0,
-                end: 0.1,
-            },
-        ];
-        let twin = Twin::from_truth("two", &start, &joints);
-        TwinScene::new(twin.visual_object(), twin.end_configuration())
-    }
-
-    #[test]
-    fn sliders_are_in_degrees_and_metres_and_clamp() {
-        let mut s = scene();
-        let j = s.joints().to_vec();
-        assert_eq!(j.len(), 2);
-        assert_eq!((j[0].kind, j[0].unit), ("revolute", "°"));
-        assert!(
-            (j[0].upper - 60.0).abs() < 1e-3 && j[0].lower == 0.0,
-            "{j:?}"
-        );
-        assert!((j[1].end - 0.1).abs() < 1e-6 && j[1].unit == "m");
-        assert_eq!(s.slider_values(), vec![0.0, 0.0]);
-        assert!(s.set_joint(0, 200.0) && s.set_joint(1, 0.05));
-        let v = s.slider_values();
-        assert!(
-            (v[0] - 60.0).abs() < 1e-3 && (v[1] - 0.05).abs() < 1e-6,
-            "{v:?}"
-        );
-        assert!(!s.set_joint(2, 1.0) && !s.set_joint(0, f32::NAN));
-        s.set_state(true);
-        let v = s.slider_values();
-        assert!(
-            (v[0] - 60.0).abs() < 1e-3 && (v[1] - 0.1).abs() < 1e-6,
-            "{v:?}"
-        );
-        s.set_state(false);
-        assert_eq!(s.slider_values(), vec![0.0, 0.0]);
-    }
-
-    #[test]
-    fn moving_a_slider_moves_only_its_part_and_axes_are_drawn() {
-        let mut s = scene();
-        let before = s.meshes();
-        assert_eq!(before.len(), 3 + 2, "three parts and two axis rods");
-        s.set_joint(1, 0.1);
-        let after = s.meshes();
-        for (a, b) in before.iter().zip(&after) {
-            let moved = a.mesh.positions != b.mesh.positions;
-            assert_eq!(moved, a.part == 2, "part {} moved: {moved}", a.part);
-        }
-        let shifted = after[2].mesh.positions[0] - before[2].mesh.positions[0];
-        assert!(
-            (shifted - Vec3::new(0.0, 0.1, 0.0)).length() < 1e-5,
-            "{shifted}"
-        );
-        s.show_axes = false;
-        s.colour_by_part = true;
-        let plain = s.meshes();
-        assert_eq!(plain.len(), 3);
-        assert_eq!(plain[1].mesh.colors.as_ref().unwrap()[0], PALETTE[1]);
-        // The true axes are drawn, in their own colour, while asked for.
-        s.truth_axes = vec![(Vec3::ZERO, Vec3::Z)];
-        let with_truth = s.meshes();
-        assert_eq!(with_truth.len(), 4);
-        assert_eq!(with_truth[3].mesh.colors.as_ref().unwrap()[0], TRUTH_ROD);
-        s.show_truth = false;
-        assert_eq!(s.meshes().len(), 3);
-    }
-
-    #[test]
-    fn the_camera_frames_the_object_and_orbits() {
-        let mut s = scene();
-        let cam = s.camera(200, 100);
-        let (px, _) = cam.project(s.centre).unwrap();
-        assert!((px - glam::Vec2::new(100.0, 50.0)).length() < 1e-2, "{px}");
-        let p0 = cam.position();
-        s.orbit(50.0, 0.0);
-        s.zoom(2.0);
-        let p1 = s.camera(200, 100).position();
-        assert!((p1 - s.centre).length() < (p0 - s.centre).length() * 0.6);
-        s.orbit(0.0, 1e6);
-        assert!(s.camera(10, 10).position().z > s.centre.z);
     }
 }
+
+/// How much of the true parts' ghost shows: a see-through fill, and an outline round each true
+/// part (where its part id changes) so its shape reads over any colour; each fainter where the
+/// fitted surface is in front, so a hidden true part still reads without hiding the fit.
+const GHOST_FILL: [f32; 2] = [0.35, 0.15];
+const GHOST_OUTLINE: [f32; 2] = [1.0, 0.5];
+
+/// Lays the true parts' render `truth` over the fitted twin's `fitted` (same camera and size):
+/// the truth's colour at [`GHOST_FILL`] inside a part and [`GHOST_OUTLINE`] on its outline, the
+/// first value where the truth is nearer (or alone: there as alpha, so the canvas background
+/// shows through), the second where it is behind the fitted surface.
+pub fn ghost_over(fitted: &RenderedView, truth: &RenderedView) -> RgbaImage {
+    let mut out = fitted.rgba.clone();
+    let (w, h) = (truth.parts.width as usize, truth.parts.height as usize);
+    let ids = &truth.parts.ids;
+    // On the outline: a covered pixel with a 4-neighbour of another part (or none, or the edge).
+    let outline = |i: usize| {
+        let (x, y) = (i % w, i / w);
+        let other = |j: usize| ids.get(j).is_none_or(|&id| id != ids[i]);
+        x == 0
+            || y == 0
+            || x + 1 >= w
+            || y + 1 >= h
+            || other(i - 1)
+            || other(i + 1)
+            || other(i - w)
+            || other(i + w)
+    };
+    let n = ids.len();
+    let same_size = [out.pixels.len(), truth.rgba.pixels.len()] == [4 * n; 2]
+        && [fitted.depth_metres.len(), truth.depth_metres.len()] == [n; 2];
+    if n != w * h || !same_size {
+        return out; // not two renders of one view: nothing to lay over
+    }
+    for (i, px) in out.pixels.chunks_exact_mut(4).enumerate() {
+        let ghost = &truth.rgba.pixels[4 * i..4 * i + 4];
+        if ghost[3] == 0 {
+            continue;
+        }
+        let empty = px[3] == 0;
+        let behind = !empty && truth.depth_metres[i] > fitted.depth_metres[i];
+        let shares = if outline(i) {
+            GHOST_OUTLINE
+        } else {
+            GHOST_FILL
+        };
+        let a = shares[usize::from(behind)];
+        for c in 0..3 {
+            let under = if empty { ghost[c] } else { px[c] } as f32;
+            px[c] = (under + (ghost[c] as f32 - under) * a).round() as u8;
+        }
+        if empty {
+            px[3] = (255.0 * a).round() as u8;
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests;

@@ -32,3 +32,4 @@ mod render_gt;
 mod synth_objects;
 mod urdf_folder;
 mod urdf_zip;
+mod viewer_opening;

@@ -18,6 +18,7 @@ import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 import { checkUrdfZip } from "./urdf.mjs";
+import { checkResultViewer } from "./result.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
 // the browser) asserts the issue's 0.5° / 5 mm (docs/results.md, "Browser vs native").
@@ -366,6 +367,7 @@ try {
     check(dark > 30, `the true axes are drawn, in black (${dark} dark pixels go with them)`);
     check(coloured > 30, `the fitted axes are drawn, in colour (${coloured} coloured pixels go with them)`);
   });
+  await step("play, legend and true parts", () => checkResultViewer({ page, check, artefacts }));
 
   // 5. downloads ---------------------------------------------------------------------------
   await step("downloads", async () => {
