@@ -7,6 +7,7 @@ import { setupInput, showDataset } from "./input.js";
 import { wireFitButtons, runFit, markFitDone } from "./fit-ui.js";
 import { wireResultButtons, showResult, clearResult } from "./result-ui.js";
 import { setupBudgets, showPresetBudget, budgetOverrides } from "./budget-ui.js";
+import { setPartColours } from "./articulation-ui.js";
 
 const params = new URLSearchParams(location.search);
 const maxSize = Number(params.get("max") ?? 1000003);
@@ -344,9 +345,11 @@ async function main() {
     } catch (e) {
       throw new Error(`the wasm module (web/pkg) did not load: ${errorText(e)}; build it with web/build.sh`);
     }
-    const missing = ["adapter_report", "gpu_self_test", "catalogue", "preset_budget", "fit", "Dataset", "Viewer"].filter((n) => !wasm[n]);
+    const missing = ["adapter_report", "gpu_self_test", "catalogue", "preset_budget", "fit", "Dataset", "Viewer", "part_colours"].filter((n) => !wasm[n]);
     if (missing.length) throw new Error(`web/pkg is out of date (missing ${missing.join(", ")}): rebuild it with web/build.sh`);
     await wasm.default();
+    // The articulation's pictures are tinted with the viewer's part colours ("#rrggbb").
+    setPartColours(wasm.part_colours().map((hex) => [1, 3, 5].map((i) => parseInt(hex.slice(i, i + 2), 16))));
     catalogue = JSON.parse(wasm.catalogue());
     window.artmeshCatalogue = catalogue;
     fillForms();
