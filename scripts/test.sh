@@ -41,6 +41,11 @@ export WASM_BINDGEN_TEST_TIMEOUT=${WASM_BINDGEN_TEST_TIMEOUT:-900}
 cargo test --target wasm32-unknown-unknown --test web
 
 step "page end-to-end test (playwright-core + Debian Chromium, serving target/web-dist)"
-(cd web && ARTMESH_WEB_ROOT=../target/web-dist node test/page.mjs)
+# The README's web command runs beside it, as a fresh clone would run it; the test opens that page too.
+serve_port=${ARTMESH_SERVE_PORT:-8765}
+ARTMESH_WEB_PROFILE=dev web/build.sh --serve "$serve_port" > target/web-serve.log 2>&1 &
+serve_pid=$!
+trap 'kill "$serve_pid" 2>/dev/null || true' EXIT
+(cd web && ARTMESH_WEB_ROOT=../target/web-dist ARTMESH_SERVE_URL="http://127.0.0.1:$serve_port/" node test/page.mjs)
 
 step "all tests passed"

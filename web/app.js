@@ -8,6 +8,7 @@ import { wireFitButtons, runFit, markFitDone } from "./fit-ui.js";
 import { wireResultButtons, showResult, clearResult } from "./result-ui.js";
 import { setupBudgets, showPresetBudget, budgetOverrides } from "./budget-ui.js";
 import { setPartColours } from "./articulation-ui.js";
+import { estimateText, recordFit } from "./estimate.js";
 
 const params = new URLSearchParams(location.search);
 const maxSize = Number(params.get("max") ?? 1000003);
@@ -152,6 +153,10 @@ function choosePreset(name) {
   return true;
 }
 
+/** Rewrites both presets' descriptions (their estimates depend on the adapter and past fits). */
+const describers = [];
+const describePresets = () => describers.forEach((f) => f());
+
 function fillForms() {
   const d = catalogue.default ?? {};
   const cat = $("demo-category");
@@ -164,8 +169,11 @@ function fillForms() {
     for (const p of catalogue.presets) option(select, p.name, p.name);
     select.value = preset;
     const describe = () => {
-      about.textContent = catalogue.presets.find((p) => p.name === select.value)?.about ?? "";
+      const p = catalogue.presets.find((p) => p.name === select.value);
+      const d = document.body.dataset;
+      about.textContent = [p?.about ?? "", estimateText(d.adapter, d.software === "true", p?.budget)].filter(Boolean).join(". ");
     };
+    describers.push(describe);
     select.addEventListener("change", describe);
     // The budgets section follows the preset chosen last.
     select.addEventListener("change", () => showPresetBudget(select.value));
@@ -294,7 +302,16 @@ async function doFit(ds, preset, budget, what) {
     document.body.dataset.fit = "error";
     return;
   }
+  const t0 = performance.now();
   const r = await runFit(wasm.fit, handle, preset, budget, what);
+  if (r) {
+    try {
+      recordFit(document.body.dataset.adapter, JSON.parse(wasm.preset_budget(preset, budget)).budget, (performance.now() - t0) / 1000);
+      describePresets();
+    } catch (e) {
+      console.warn("fit time not recorded:", e);
+    }
+  }
   if (!r) {
     $("result-empty").textContent = "No twin: the fit did not finish.";
     return;
@@ -368,6 +385,7 @@ async function main() {
     $("demo-run").addEventListener("click", runDemo);
     $("fit-run").addEventListener("click", fitCurrent);
     const ok = await gpuSection();
+    describePresets();
     updateButtons();
     if (document.body.dataset.state !== "panic") document.body.dataset.state = ok ? "done" : "error";
   } catch (e) {

@@ -17,7 +17,7 @@ import { tmpdir } from "node:os";
 import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
-import { checkUrdfZip } from "./urdf.mjs";
+import { checkSharedObjectFit, checkUrdfZip } from "./urdf.mjs";
 import { checkResultViewer } from "./result.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
@@ -121,6 +121,8 @@ try {
     if (state.software === "true") {
       const presets = [await page.inputValue("#demo-preset"), await page.inputValue("#fit-preset")];
       check(presets.every((p) => p === "tiny"), `a software adapter starts at the tiny preset (${presets.join(", ")})`);
+      const about = await page.locator("#demo-preset-about").textContent();
+      check(/Estimated fit time: about \d+ s/.test(about), `the time a tiny fit takes is shown before it starts: ${about}`);
     }
     await page.click("#selftest-run");
     await page.waitForFunction(() => ["pass", "fail"].includes(document.body.dataset.selftest) ||
@@ -131,6 +133,28 @@ try {
     check(rows >= 20, `self-test table shows ${rows} checks`);
     await page.screenshot({ path: artefacts + "web-selftest.png", fullPage: true });
     await accessibility("the landing page");
+  });
+
+  // 1b. the README's web command: the page `web/build.sh --serve` serves (scripts/test.sh starts it)
+  await step("web/build.sh --serve", async () => {
+    const served = process.env.ARTMESH_SERVE_URL;
+    if (!served) { note("ARTMESH_SERVE_URL not set: web/build.sh --serve is checked by scripts/test.sh"); return; }
+    let up = false;
+    for (let i = 0; i < 240 && !up; i++) {
+      up = await fetch(served).then((r) => r.ok, () => false);
+      if (!up) await new Promise((r) => setTimeout(r, 500));
+    }
+    if (!check(up, `web/build.sh --serve answers at ${served}`)) return;
+    const other = await context.newPage();
+    try {
+      await other.goto(served);
+      await other.waitForFunction(() => document.body.dataset.state !== "loading", null, { timeout: 300_000 });
+      const state = await other.evaluate(() => ({ ...document.body.dataset }));
+      check(state.state === "done" && Boolean(state.adapter),
+        `the page web/build.sh --serve serves starts (state=${state.state}, adapter ${state.adapter})`);
+    } finally {
+      await other.close();
+    }
   });
 
   // 2. a native demo's dataset fitted in the page ------------------------------------------
@@ -439,11 +463,22 @@ try {
   await step("malformed dataset", async () => {
     const good = join(work, "good"), broken = join(work, "broken");
     native(["sample", "--out", good, "--width", "24", "--height", "16", "--views", "3"]);
+    // Loaded with the keyboard alone: Tab from the top of the page to the folder picker, Enter opens
+    // the browser's chooser (the one step that is the operating system's), the dataset loads.
     await clearFlags("dataset");
-    await page.setInputFiles("#folder", good);
+    await page.evaluate(() => { document.activeElement?.blur(); window.scrollTo(0, 0); });
+    let presses = 0, focused = null;
+    while (presses < 80 && focused !== "folder") {
+      await page.keyboard.press("Tab");
+      presses++;
+      focused = await page.evaluate(() => document.activeElement?.id ?? null);
+    }
+    check(focused === "folder", `Tab reaches the folder picker (${presses} presses)`);
+    const [chooser] = await Promise.all([page.waitForEvent("filechooser", { timeout: 10_000 }), page.keyboard.press("Enter")]);
+    await chooser.setFiles(good);
     await page.waitForFunction(() => document.body.dataset.dataset, null, { timeout: 60_000 });
     const goodText = await page.locator("#dataset-result").textContent();
-    check((await body()).dataset === "ok", `sample dataset accepted: ${goodText.split("\n")[0]}`);
+    check((await body()).dataset === "ok", `sample dataset loaded with the keyboard alone: ${goodText.split("\n")[0]}`);
 
     await cp(good, broken, { recursive: true });
     const png = join(broken, "end", "train", "rgba", "0001.png");
@@ -522,6 +557,7 @@ try {
   });
 
   await step("zipped URDF", () => checkUrdfZip({ page, check, native, work }));
+  await step("a shared object fitted", () => checkSharedObjectFit({ page, check, work, artefacts }));
   // 7. nothing leaves the page -------------------------------------------------------------
   await step("offline", async () => {
     const foreign = requests.filter((r) => /^https?:/i.test(r) && !r.startsWith(url));
