@@ -19,6 +19,7 @@ import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 import { checkSharedObjectFit, checkUrdfZip } from "./urdf.mjs";
 import { checkResultViewer } from "./result.mjs";
+import { checkMobileAndTouch } from "./touch.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
 // the browser) asserts the issue's 0.5° / 5 mm (docs/results.md, "Browser vs native").
@@ -392,6 +393,7 @@ try {
     check(coloured > 30, `the fitted axes are drawn, in colour (${coloured} coloured pixels go with them)`);
   });
   await step("play, legend and true parts", () => checkResultViewer({ page, check, artefacts }));
+  await step("phone width and touch", () => checkMobileAndTouch({ page, browser, url, check, native, work, artefacts }));
 
   // 5. downloads ---------------------------------------------------------------------------
   await step("downloads", async () => {
