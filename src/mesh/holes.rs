@@ -41,6 +41,44 @@ pub fn close_short_holes(
     if max_edges < 3 {
         return (Vec::new(), stats);
     }
+    let (loops, mut edges) = boundary_loops(faces);
+    let mut added = Vec::new();
+    for BoundaryLoop {
+        mut vertices,
+        along,
+    } in loops
+    {
+        stats.loops += 1;
+        if vertices.len() > max_edges {
+            continue;
+        }
+        // Faces run a→b along a boundary edge; the hole's own faces must run b→a.
+        if 2 * along > vertices.len() {
+            vertices.reverse();
+        }
+        if let Some(fill) = least_area_fill(positions, &vertices, &mut edges) {
+            stats.closed += 1;
+            stats.faces += fill.len();
+            added.extend(fill);
+        }
+    }
+    (added, stats)
+}
+
+pub(super) fn undirected(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// A simple boundary loop of a mesh, in its walking order.
+pub(super) struct BoundaryLoop {
+    /// The loop's vertices (no vertex twice); edge `i` runs from `vertices[i]` to the next.
+    pub vertices: Vec<u32>,
+    /// How many of its edges the adjacent face runs in the walking direction.
+    pub along: usize,
+}
+
+/// The boundary of `faces` as simple loops (see [`simple_loops`]), and every edge of the mesh.
+pub(super) fn boundary_loops(faces: &[[u32; 3]]) -> (Vec<BoundaryLoop>, HashSet<(u32, u32)>) {
     // Per undirected edge: uses, and the direction of its first face.
     let mut uses: HashMap<(u32, u32), (u32, (u32, u32))> = HashMap::new();
     let mut order = Vec::new(); // edges in order of first use, so the output is deterministic
@@ -55,34 +93,20 @@ pub fn close_short_holes(
         }
     }
     let boundary: Vec<(u32, u32)> = order.iter().copied().filter(|e| uses[e].0 == 1).collect();
-    let mut edges: HashSet<(u32, u32)> = order.into_iter().collect();
-    let mut added = Vec::new();
-    for mut hole in simple_loops(&boundary) {
-        stats.loops += 1;
-        if hole.len() > max_edges {
-            continue;
-        }
-        // Faces run a→b along a boundary edge; the hole's own faces must run b→a.
-        let along = (0..hole.len())
-            .filter(|&i| {
-                let (a, b) = (hole[i], hole[(i + 1) % hole.len()]);
-                uses[&undirected(a, b)].1 == (a, b)
-            })
-            .count();
-        if 2 * along > hole.len() {
-            hole.reverse();
-        }
-        if let Some(fill) = least_area_fill(positions, &hole, &mut edges) {
-            stats.closed += 1;
-            stats.faces += fill.len();
-            added.extend(fill);
-        }
-    }
-    (added, stats)
-}
-
-fn undirected(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
+    let loops = simple_loops(&boundary)
+        .into_iter()
+        .map(|vertices| {
+            let n = vertices.len();
+            let along = (0..n)
+                .filter(|&i| {
+                    let (a, b) = (vertices[i], vertices[(i + 1) % n]);
+                    uses[&undirected(a, b)].1 == (a, b)
+                })
+                .count();
+            BoundaryLoop { vertices, along }
+        })
+        .collect();
+    (loops, order.into_iter().collect())
 }
 
 /// The `boundary` edges as simple loops (no vertex twice). Every vertex of a mesh's boundary has

@@ -60,17 +60,36 @@ impl KdTree {
             .map(|(i, d2)| (self.input[i] as usize, d2))
     }
 
+    /// The input index of the point nearest to `q` among those whose input index passes `keep`,
+    /// and its squared distance; `None` when no point passes.
+    pub(crate) fn nearest_index_where(
+        &self,
+        q: Vec3,
+        keep: impl Fn(usize) -> bool,
+    ) -> Option<(usize, f64)> {
+        let mut best = (f64::INFINITY, usize::MAX);
+        self.search(q.as_dvec3(), 0, self.points.len(), &mut best, &keep);
+        (best.1 < self.points.len()).then(|| (self.input[best.1] as usize, best.0))
+    }
+
     /// Where in the tree's order the point nearest to `q` is stored, and its squared distance.
     fn nearest_slot(&self, q: Vec3) -> Option<(usize, f64)> {
         let mut best = (f64::INFINITY, usize::MAX);
-        self.search(q.as_dvec3(), 0, self.points.len(), &mut best);
+        self.search(q.as_dvec3(), 0, self.points.len(), &mut best, &|_| true);
         (best.1 < self.points.len()).then_some((best.1, best.0))
     }
 
-    fn search(&self, q: glam::DVec3, lo: usize, hi: usize, best: &mut (f64, usize)) {
+    fn search<F: Fn(usize) -> bool>(
+        &self,
+        q: glam::DVec3,
+        lo: usize,
+        hi: usize,
+        best: &mut (f64, usize),
+        keep: &F,
+    ) {
         let consider = |i: usize, best: &mut (f64, usize)| {
             let d2 = q.distance_squared(self.points[i].as_dvec3());
-            if d2 < best.0 {
+            if d2 < best.0 && keep(self.input[i] as usize) {
                 *best = (d2, i);
             }
         };
@@ -90,10 +109,10 @@ impl KdTree {
         } else {
             ((m + 1, hi), (lo, m))
         };
-        self.search(q, near.0, near.1, best);
+        self.search(q, near.0, near.1, best, keep);
         // The far side can only hold a closer point if the splitting plane is closer than the best so far.
         if diff * diff < best.0 {
-            self.search(q, far.0, far.1, best);
+            self.search(q, far.0, far.1, best, keep);
         }
     }
 }

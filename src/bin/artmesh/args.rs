@@ -115,6 +115,10 @@ pub struct BudgetArgs {
     /// at most 256) [default: 48].
     #[arg(long)]
     close_holes: Option<usize>,
+    /// Then zip a thin part's two sides together where their rims stay within this many median
+    /// edge lengths of each other (0: none) [default: 3].
+    #[arg(long)]
+    rim_gap: Option<f32>,
     /// Decimate the exported twin's visual meshes to at most this many faces over all parts (0: no
     /// limit) [default: 100000].
     #[arg(long)]
@@ -148,6 +152,14 @@ impl BudgetArgs {
                 ));
             }
             config.reconstruction.close_holes = n;
+        }
+        if let Some(g) = self.rim_gap {
+            if !(g.is_finite() && g >= 0.0) {
+                return Err(format!(
+                    "--rim-gap: expected a non-negative number of edge lengths, found {g}"
+                ));
+            }
+            config.reconstruction.rim_gap = g;
         }
         if let Some(n) = self.max_visual_faces {
             config.max_visual_faces = n;

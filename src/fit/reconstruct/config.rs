@@ -78,6 +78,9 @@ pub struct ReconstructionConfig {
     /// After that, each part's holes bounded by at most this many boundary edges are closed
     /// (0 = none).
     pub close_holes: usize,
+    /// Then boundary runs that stay within this many median edge lengths of another loop's
+    /// boundary (a thin part's two sides at its rim) are zipped together (0 = none).
+    pub rim_gap: f32,
     /// Iterations of the fixed-topology recovery stage.
     pub recovery_iterations: u32,
     /// Position learning rate of the recovery stage (decayed ×0.1 over it).
@@ -203,6 +206,7 @@ impl ReconstructionConfig {
             // Quick suite (fast): closing loops up to 48 / 96 edges leaves 3.8 / 1.9 % boundary
             // edges (11.9 % with none); 96 also spans real openings (CD-m 3.61 -> 3.75 mm).
             close_holes: 48,
+            rim_gap: 3.0,
             recovery_iterations: budget.recovery_iterations,
             recovery_position_lr: 2e-5,
         }

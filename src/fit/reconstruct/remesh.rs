@@ -11,7 +11,9 @@ use crate::mesh::topology::{
     compact, cross_part_faces, drop_small_components, face_part, median_edge, thin_vertices,
     vertex_normals,
 };
-use crate::mesh::{close_short_holes, harden_parts, part_aware_remesh, restricted_delaunay};
+use crate::mesh::{
+    close_short_holes, harden_parts, part_aware_remesh, restricted_delaunay, stitch_rims,
+};
 use crate::raster::{MeshField, SH_FLOATS};
 
 /// Fewer measured points than this and a part keeps its optimised vertices.
@@ -88,11 +90,7 @@ pub(super) fn remesh(
             .filter(|(_, k)| *k)
             .map(|(f, _)| f)
             .collect();
-        let (fill, holes) = close_short_holes(&used.positions, &own, config.close_holes);
-        stats.holes.loops += holes.loops;
-        stats.holes.closed += holes.closed;
-        stats.holes.faces += holes.faces;
-        fills.extend(fill);
+        fills.extend(close_part(&used.positions, own, config, &mut stats));
     }
     stats.floater_faces = keep.iter().filter(|k| !**k).count();
     let faces: Vec<[u32; 3]> = faces
@@ -113,6 +111,36 @@ pub(super) fn remesh(
         logits[k as usize] = 10.0;
     }
     (out, stats)
+}
+
+/// The faces that close one part's `own` faces: its short holes, then its rims where a thin
+/// part's two sides run side by side, then the short holes the zips left.
+fn close_part(
+    positions: &[Vec3],
+    mut own: Vec<[u32; 3]>,
+    config: &ReconstructionConfig,
+    stats: &mut RemeshStats,
+) -> Vec<[u32; 3]> {
+    let kept = own.len();
+    let close_holes = |own: &mut Vec<[u32; 3]>, stats: &mut RemeshStats| {
+        let (fill, holes) = close_short_holes(positions, own, config.close_holes);
+        stats.holes.loops += holes.loops;
+        stats.holes.closed += holes.closed;
+        stats.holes.faces += holes.faces;
+        own.extend(fill);
+    };
+    close_holes(&mut own, stats);
+    if config.rim_gap > 0.0 && !own.is_empty() {
+        let gap = config.rim_gap * median_edge(positions, &own);
+        let (strip, rims) = stitch_rims(positions, &own, gap);
+        stats.rims.zipped += rims.zipped;
+        stats.rims.faces += rims.faces;
+        if !strip.is_empty() {
+            own.extend(strip);
+            close_holes(&mut own, stats);
+        }
+    }
+    own.split_off(kept)
 }
 
 /// Whether `measured` has enough points of each of `num_parts` parts to replace them all.

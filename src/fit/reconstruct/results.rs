@@ -86,6 +86,8 @@ pub struct RemeshStats {
     pub unused_vertices: usize,
     /// Boundary loops of the rebuilt parts and those closed (`close_holes`).
     pub holes: crate::mesh::HoleStats,
+    /// Rim runs zipped to their other side (`rim_gap`), and the faces that took.
+    pub rims: crate::mesh::RimStats,
 }
 
 /// One state's reconstruction.
