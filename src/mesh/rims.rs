@@ -44,7 +44,10 @@ pub struct RimStats {
 /// loop backwards (the two sides of a rim run opposite ways) is zipped to that stretch (or fanned
 /// to one vertex where the matches stay on it), the whole loop when every vertex matched. A zip
 /// that would reuse an edge the mesh or an earlier zip already has is skipped, so a manifold
-/// mesh stays manifold.
+/// mesh stays manifold. The two edges of a narrow band seen from one side also run side by side
+/// opposite ways; their strip folds back under the band and gives it a back face, as a thin plate
+/// has. Refusing such folds was measured: the quick suite's CD-s rose 9.89 -> 10.14 mm (storage
+/// furniture 25.94 -> 29.86) and no figure improved.
 pub fn stitch_rims(
     positions: &[Vec3],
     faces: &[[u32; 3]],

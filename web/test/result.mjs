@@ -5,14 +5,20 @@
 // picture, and off restores it) and the opening view's score; no console errors meanwhile.
 import { writeFile } from "node:fs/promises";
 
-/** The viewer canvas's RGBA bytes. */
+// Canvas reads stay in the page (copying a canvas out to node took most of a minute over the
+// checks); node holds snapshot ids.
+
+/** Keeps a copy of the viewer canvas's RGBA bytes in the page; its id. */
 const pixels = (page) => page.evaluate(() => {
   const c = document.getElementById("viewer");
-  return Array.from(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
+  const snaps = (window.__viewerSnaps ||= []);
+  snaps.push(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
+  return snaps.length - 1;
 });
 
-/** Pixels that differ by more than a little between two reads. */
-function changed(a, b) {
+/** Pixels that differ by more than a little between two snapshots (ids from `pixels`). */
+const changed = (page, a, b) => page.evaluate(([a, b]) => {
+  [a, b] = [window.__viewerSnaps[a], window.__viewerSnaps[b]];
   if (a.length !== b.length) return Infinity;
   let n = 0;
   for (let i = 0; i < a.length; i += 4) {
@@ -20,7 +26,7 @@ function changed(a, b) {
       Math.abs(a[i + 3] - b[i + 3]) > 12) n++;
   }
   return n;
-}
+}, [a, b]);
 
 /** Reads the canvas until two reads `gap` ms apart agree (draws in flight have landed); the
  * last difference seen, 0 when it settled. */
@@ -29,7 +35,7 @@ async function settle(page, gap = 900, tries = 5) {
   for (let i = 0; i < tries && diff > 0; i++) {
     await page.waitForTimeout(gap);
     const now = await pixels(page);
-    diff = changed(last, now);
+    diff = await changed(page, last, now);
     last = now;
   }
   return { diff, image: last };
@@ -37,10 +43,25 @@ async function settle(page, gap = 900, tries = 5) {
 
 const pressed = (page) => page.getAttribute("#play", "aria-pressed");
 
-/** sRGB byte → linear, and a colour's channel ratios (what shading leaves alone). */
-const linear = (v) => { const s = v / 255; return s <= 0.04045 ? s / 12.92 : ((s + 0.055) / 1.055) ** 2.4; };
-const ratios = (rgb) => { const l = rgb.map(linear); const m = Math.max(...l, 1e-6); return l.map((x) => x / m); };
 const hex = (h) => [1, 3, 5].map((i) => parseInt(h.slice(i, i + 2), 16));
+
+/** Per colour (RGB bytes), the lit pixels of snapshot `id` with its channel ratios (what shading
+ * leaves alone), counted in the page. */
+const pixelsOfColours = (page, id, colours) => page.evaluate(([id, colours]) => {
+  const linear = (v) => { const s = v / 255; return s <= 0.04045 ? s / 12.92 : ((s + 0.055) / 1.055) ** 2.4; };
+  const ratios = (rgb) => { const l = rgb.map(linear); const m = Math.max(...l, 1e-6); return l.map((x) => x / m); };
+  const image = window.__viewerSnaps[id];
+  return colours.map((rgb) => {
+    const want = ratios(rgb);
+    let n = 0;
+    for (let i = 0; i < image.length; i += 4) {
+      if (image[i + 3] !== 255) continue;
+      const got = ratios([image[i], image[i + 1], image[i + 2]]);
+      if (got.every((x, c) => Math.abs(x - want[c]) < 0.08)) n++;
+    }
+    return n;
+  });
+}, [id, colours]);
 
 async function checkPlay(page, check) {
   if (!check(await page.locator("#play").isVisible(), "the play button is shown")) return;
@@ -57,7 +78,8 @@ async function checkPlay(page, check) {
   for (let i = 0; i < 8 && moving < 2; i++) {
     await page.waitForTimeout(700);
     const now = await pixels(page);
-    if (changed(previous, now) > 50) { moving++; frames.push(changed(previous, now)); }
+    const diff = await changed(page, previous, now);
+    if (diff > 50) { moving++; frames.push(diff); }
     previous = now;
   }
   check(moving >= 2, `the picture moves while playing (${frames.join(", ") || "no"} pixels changed between reads)`);
@@ -103,16 +125,7 @@ async function checkLegend(page, check, artefacts) {
     e.swatch === `rgb(${hex(e.colour).join(", ")})`);
   check(palette.length > 0 && same, `the swatches are wasm's part_colours() (${palette.join(" ")})`);
   // Each part's colour is in the picture: lit pixels keep a colour's channel ratios.
-  const found = legend.map((e) => {
-    const want = ratios(hex(e.colour));
-    let n = 0;
-    for (let i = 0; i < image.length; i += 4) {
-      if (image[i + 3] !== 255) continue;
-      const got = ratios([image[i], image[i + 1], image[i + 2]]);
-      if (got.every((x, c) => Math.abs(x - want[c]) < 0.08)) n++;
-    }
-    return n;
-  });
+  const found = await pixelsOfColours(page, image, legend.map((e) => hex(e.colour)));
   check(found.every((n) => n >= 5), `every legend colour is drawn on the canvas (pixels per part: ${found.join(", ")})`);
   await page.locator("#result").screenshot({ path: artefacts + "web-result-legend.png" });
   await page.evaluate(() => {
@@ -133,11 +146,11 @@ async function checkTruthParts(page, check, artefacts) {
   const off = (await settle(page)).image;
   await toggle(true);
   const on = (await settle(page)).image;
-  const diff = changed(off, on);
+  const diff = await changed(page, off, on);
   check(diff > 100, `showing the true parts changes the picture (${diff} pixels)`);
   await writeFile(artefacts + "web-viewer-truth-parts.png", await page.locator("#viewer").screenshot());
   await toggle(false);
-  const back = changed(off, (await settle(page)).image);
+  const back = await changed(page, off, (await settle(page)).image);
   check(back === 0, `hiding them again restores the picture (${back} pixels differ)`);
 }
 
