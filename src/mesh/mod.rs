@@ -1,8 +1,9 @@
 //! Mesh operations of the reconstruction phase, on the CPU copy of the mesh field: part-aware
 //! restricted Delaunay remeshing ([`restricted_delaunay`], [`part_aware_remesh`]) and the topology
 //! edits around it (densification splits, pruning, hardening, connectivity counts, closing short
-//! holes, stitching thin parts' rims, decimation to a face budget for the exports), the closest-point queries the articulation phase matches vertices with ([`closest`]),
-//! and the k-d tree nearest-neighbour search over point sets ([`spatial`]).
+//! holes, stitching thin parts' rims, decimation to a face budget for the exports), the
+//! closest-point queries the articulation phase matches vertices with ([`closest`]), and the k-d
+//! tree nearest-neighbour search over point sets ([`spatial`]).
 
 pub mod closest;
 mod decimate;

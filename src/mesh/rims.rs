@@ -70,7 +70,6 @@ pub fn stitch_rims(
             },
         )
         .collect();
-    let lens: Vec<usize> = loops.iter().map(Vec::len).collect();
     let all: Vec<(usize, usize)> = loops
         .iter()
         .enumerate()
@@ -102,7 +101,7 @@ pub fn stitch_rims(
                 (d2.sqrt() <= max_gap as f64).then_some(all[k])
             })
             .collect();
-        for run in runs(&matches, &lens) {
+        for run in runs(&matches, &loops) {
             let b_loop = &loops[run.partner];
             let Some((chain_a, chain_b)) = run.chains(a_loop, b_loop) else {
                 continue;
@@ -180,15 +179,15 @@ fn back_step(from: usize, to: usize, n: usize) -> i64 {
     }
 }
 
-/// The maximal runs of at least [`MIN_RUN`] consecutive vertices whose matches walk one loop
-/// (of `lens[l]` vertices) backwards in steps of at most [`MAX_STEP`] (or [`MAX_JITTER`] forward), cyclic over the loop (a run
-/// may wrap past its end).
-fn runs(matches: &[Option<(usize, usize)>], lens: &[usize]) -> Vec<Run> {
+/// The maximal runs of at least [`MIN_RUN`] consecutive vertices whose matches walk one of
+/// `loops` backwards in steps of at most [`MAX_STEP`] (or [`MAX_JITTER`] forward), cyclic over the
+/// loop (a run may wrap past its end).
+fn runs(matches: &[Option<(usize, usize)>], loops: &[Vec<u32>]) -> Vec<Run> {
     let n = matches.len();
     // Whether vertex i + 1 continues vertex i's run.
     let continues = |i: usize| match (matches[i % n], matches[(i + 1) % n]) {
         (Some((l, j)), Some((next, k))) => {
-            l == next && (-MAX_JITTER..=MAX_STEP as i64).contains(&back_step(j, k, lens[l]))
+            l == next && (-MAX_JITTER..=MAX_STEP as i64).contains(&back_step(j, k, loops[l].len()))
         }
         _ => false,
     };
@@ -328,6 +327,14 @@ mod tests {
         (p, faces)
     }
 
+    /// Two faces joining the [`slab`]'s sides over the rim square at `x` along y = 0, oriented
+    /// like the slab's faces.
+    fn joined_at(n: u32, x: u32) -> [[u32; 3]; 2] {
+        let side = n + 1;
+        let (t, b) = (|x: u32| x, |x: u32| side * side + x);
+        [[t(x + 1), t(x), b(x)], [b(x), b(x + 1), t(x + 1)]]
+    }
+
     #[test]
     fn a_thin_slab_is_closed_at_its_rim_and_stays_oriented() {
         let (p, mut faces) = slab(4, 0.3);
@@ -387,10 +394,8 @@ mod tests {
         // and back down the other's.
         let n = 16;
         let (p, mut faces) = slab(n, 0.3);
-        let side = n + 1;
-        let (t, b) = (|x: u32| x, |x: u32| side * side + x);
         for x in 0..n {
-            faces.extend([[t(x + 1), t(x), b(x)], [b(x), b(x + 1), t(x + 1)]]);
+            faces.extend(joined_at(n, x));
         }
         assert_eq!(edge_counts(&faces).boundary, 2 * 3 * n as usize + 2);
         let (strip, stats) = stitch_rims(&p, &faces, 0.5);
@@ -413,9 +418,7 @@ mod tests {
         // faces that would meet that join, and closing short holes closes what that leaves.
         let n = 12;
         let (p, mut faces) = slab(n, 0.3);
-        let side = n + 1;
-        let (t, b) = (|x: u32| x, |x: u32| side * side + x);
-        faces.extend([[t(6), t(5), b(5)], [b(5), b(6), t(6)]]);
+        faces.extend(joined_at(n, 5));
         let (strip, stats) = stitch_rims(&p, &faces, 0.5);
         assert!(stats.zipped >= 1, "{stats:?}");
         faces.extend(&strip);
