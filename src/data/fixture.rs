@@ -391,6 +391,34 @@ pub fn artgs_style_files(ds: &Dataset) -> Result<FileSet, DataError> {
     Ok(files)
 }
 
+/// A `size`² frame seen from `eye` looking down −z (1 rad wide) whose depth is `depth_at(x, y)`
+/// metres where that is `Some` (opaque there) and background elsewhere: what depth-evidence tests
+/// look through.
+pub fn depth_frame(eye: Vec3, size: u32, depth_at: &dyn Fn(u32, u32) -> Option<f32>) -> Frame {
+    let pixels = (0..size * size).map(|i| depth_at(i % size, i / size));
+    Frame {
+        name: "0000".into(),
+        camera: Camera::from_fov(look_at(eye, eye - Vec3::Z, Vec3::Y), size, size, 1.0, None),
+        time: 0.0,
+        rgba: RgbaImage {
+            width: size,
+            height: size,
+            pixels: pixels
+                .clone()
+                .flat_map(|d| [9, 9, 9, if d.is_some() { 255 } else { 0 }])
+                .collect(),
+        },
+        depth: Some(DepthMap {
+            width: size,
+            height: size,
+            millimetres: pixels
+                .map(|d| d.map_or(0, |d| (d * 1000.0) as u16))
+                .collect(),
+        }),
+        parts: None,
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

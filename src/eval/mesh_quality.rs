@@ -239,6 +239,8 @@ pub struct MeshSummary {
     pub split_parts: usize,
     /// Short holes closed after remeshing.
     pub holes_closed: usize,
+    /// Fill faces left out because the views saw through them.
+    pub fill_faces_refused: usize,
 }
 
 impl MeshSummary {
@@ -274,6 +276,7 @@ impl MeshSummary {
             cross_part_faces: self.cross_part_faces + other.cross_part_faces,
             split_parts: self.split_parts + other.split_parts,
             holes_closed: self.holes_closed + other.holes_closed,
+            fill_faces_refused: self.fill_faces_refused + other.fill_faces_refused,
         }
     }
 }
@@ -285,6 +288,7 @@ pub fn mesh_summary(reconstruction: &Reconstruction, gt: &[Option<GtMeshes>; 2])
     for s in &reconstruction.states {
         sum.cross_part_faces += crate::mesh::topology::cross_part_faces(&s.field.faces, &s.parts);
         sum.holes_closed += s.remesh.holes.closed;
+        sum.fill_faces_refused += s.remesh.holes.refused_faces;
         for (k, mesh) in s.part_meshes.iter().enumerate() {
             sum.add_part(&part_topology(
                 k,

@@ -7,6 +7,8 @@
 //! - [`chamfer`]: area-weighted surface sampling, k-d tree nearest neighbours, `cd_peer` and `cd_mm`.
 //! - [`mesh_quality`]: per-part components, boundary / non-manifold / cross-part counts and Chamfer of a
 //!   reconstruction ([`reconstruction_report`]).
+//! - [`seen`]: what the training views' depth sees of the static part, and the CD-s a fit of only that
+//!   can reach ([`StaticBound`]), beside the metric's sampling floor.
 //! - [`report`]: [`ObjectMetrics`] per object ([`evaluate_object`], or [`evaluate_fit`] for a fit
 //!   against its dataset's ground truth), serialisable to JSON.
 //! - [`tables`]: part-count buckets (2 / 3 / 4-5 / 6+ / All, the paper's Table 1) and per-category columns (the
@@ -23,6 +25,7 @@ pub mod chamfer;
 pub mod joints;
 pub mod mesh_quality;
 pub mod report;
+pub mod seen;
 pub mod tables;
 
 pub use crate::synth::PartBucket;
@@ -38,6 +41,7 @@ pub use mesh_quality::{
     reconstruction_report,
 };
 pub use report::{EvalOptions, ObjectMetrics, PartChamfer, evaluate_fit, evaluate_object};
+pub use seen::{StaticBound, seen_by, static_bound};
 pub use tables::{BenchmarkTable, ColumnSummary};
 
 /// Why an object could not be evaluated.

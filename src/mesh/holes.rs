@@ -22,10 +22,14 @@ pub struct HoleStats {
     pub closed: usize,
     /// Faces added.
     pub faces: usize,
+    /// Fill faces left out because `keep` refused them (they span an opening the views saw
+    /// through); a loop all of whose fill is refused is not counted closed.
+    pub refused_faces: usize,
 }
 
 /// Faces that close every hole of `faces` (one part's) bounded by a simple loop of at most
-/// `max_edges` edges (3 or more; at most [`MAX_HOLE_EDGES`]), and what was done.
+/// `max_edges` edges (3 or more; at most [`MAX_HOLE_EDGES`]), less the fill faces `keep` refuses,
+/// and what was done.
 ///
 /// The boundary edges are split into simple loops: closed walks along unused boundary edges, cut
 /// where a walk comes back to a vertex it passed (a vertex where two holes touch, or a hole and a
@@ -35,6 +39,7 @@ pub fn close_short_holes(
     positions: &[Vec3],
     faces: &[[u32; 3]],
     max_edges: usize,
+    keep: &dyn Fn(&[u32; 3]) -> bool,
 ) -> (Vec<[u32; 3]>, HoleStats) {
     let mut stats = HoleStats::default();
     let max_edges = max_edges.min(MAX_HOLE_EDGES);
@@ -57,12 +62,44 @@ pub fn close_short_holes(
             vertices.reverse();
         }
         if let Some(fill) = least_area_fill(positions, &vertices, &mut edges) {
+            let (fill, left): (Vec<[u32; 3]>, Vec<[u32; 3]>) = fill.iter().partition(|f| keep(f));
+            if !left.is_empty() {
+                stats.refused_faces += left.len();
+                forget_diagonals(&left, &fill, &vertices, &mut edges);
+            }
+            if fill.is_empty() {
+                continue;
+            }
             stats.closed += 1;
             stats.faces += fill.len();
             added.extend(fill);
         }
     }
     (added, stats)
+}
+
+/// Takes the diagonals of the `left` faces of a fill of `hole` back out of `edges`, but for those
+/// the `kept` faces still use (the hole's own edges stay).
+fn forget_diagonals(
+    left: &[[u32; 3]],
+    kept: &[[u32; 3]],
+    hole: &[u32],
+    edges: &mut HashSet<(u32, u32)>,
+) {
+    let n = hole.len();
+    let face_edges = |f: &[u32; 3]| {
+        let f = *f;
+        (0..3).map(move |i| undirected(f[i], f[(i + 1) % 3]))
+    };
+    let own: HashSet<(u32, u32)> = (0..n)
+        .map(|i| undirected(hole[i], hole[(i + 1) % n]))
+        .chain(kept.iter().flat_map(face_edges))
+        .collect();
+    for e in left.iter().flat_map(face_edges) {
+        if !own.contains(&e) {
+            edges.remove(&e);
+        }
+    }
 }
 
 pub(super) fn undirected(a: u32, b: u32) -> (u32, u32) {
@@ -241,7 +278,7 @@ mod tests {
         let original = faces.clone();
         faces.drain(2..4); // the top (z = 1) quad
         assert_eq!(edge_counts(&faces).boundary, 4);
-        let (fill, stats) = close_short_holes(&p, &faces, 8);
+        let (fill, stats) = close_short_holes(&p, &faces, 8, &|_| true);
         assert_eq!((stats.loops, stats.closed, stats.faces), (1, 1, 2));
         faces.extend(&fill);
         let e = edge_counts(&faces);
@@ -256,13 +293,32 @@ mod tests {
     }
 
     #[test]
+    fn refused_fill_faces_stay_open_and_leave_their_diagonals_free() {
+        let (p, mut faces) = cube();
+        faces.drain(2..4);
+        let (fill, stats) = close_short_holes(&p, &faces, 8, &|_| false);
+        assert!(fill.is_empty());
+        assert_eq!((stats.loops, stats.closed, stats.refused_faces), (1, 0, 2));
+        // Two holes, the first face of the first fill refused: the rest is still closed, and
+        // stays manifold.
+        faces.drain(0..2);
+        let first = std::cell::Cell::new(true);
+        let (fill, stats) = close_short_holes(&p, &faces, 8, &|_| !first.replace(false));
+        assert_eq!((stats.loops, stats.closed, stats.refused_faces), (2, 2, 1));
+        assert_eq!(fill.len(), 3);
+        faces.extend(&fill);
+        let e = edge_counts(&faces);
+        assert_eq!((e.boundary, e.non_manifold), (3, 0));
+    }
+
+    #[test]
     fn long_loops_and_open_sheets_stay_open() {
         let (p, mut faces) = cube();
         faces.drain(2..4);
-        let (fill, stats) = close_short_holes(&p, &faces, 3);
+        let (fill, stats) = close_short_holes(&p, &faces, 3, &|_| true);
         assert!(fill.is_empty());
         assert_eq!((stats.loops, stats.closed), (1, 0));
-        let (fill, _) = close_short_holes(&p, &faces, 2);
+        let (fill, _) = close_short_holes(&p, &faces, 2, &|_| true);
         assert!(fill.is_empty());
     }
 
@@ -287,7 +343,7 @@ mod tests {
     #[test]
     fn holes_touching_at_a_vertex_are_closed_apart() {
         let (p, mut faces) = sheet_without(&[(1, 1), (2, 2)]);
-        let (fill, stats) = close_short_holes(&p, &faces, 12);
+        let (fill, stats) = close_short_holes(&p, &faces, 12, &|_| true);
         assert_eq!((stats.loops, stats.closed, stats.faces), (3, 2, 4));
         faces.extend(&fill);
         let e = edge_counts(&faces);
@@ -305,7 +361,7 @@ mod tests {
     fn a_non_convex_hole_gets_no_face_outside_it() {
         // An L-shaped hole of three squares.
         let (p, mut faces) = sheet_without(&[(1, 1), (2, 1), (1, 2)]);
-        let (fill, stats) = close_short_holes(&p, &faces, 12);
+        let (fill, stats) = close_short_holes(&p, &faces, 12, &|_| true);
         // The outer rim (18 edges) stays open; the L (8 edges) closes with 6 faces of area 3.
         assert_eq!((stats.loops, stats.closed, stats.faces), (2, 1, 6));
         let area: f32 = fill

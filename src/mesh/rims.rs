@@ -406,7 +406,7 @@ mod tests {
         // Near the joined edge the other side is too few steps along the loop to be matched:
         // two short holes are left, and closing short holes closes them.
         assert!(e.boundary <= 40, "{e:?}");
-        let (fill, _) = crate::mesh::close_short_holes(&p, &faces, 48);
+        let (fill, _) = crate::mesh::close_short_holes(&p, &faces, 48, &|_| true);
         faces.extend(fill);
         let e = edge_counts(&faces);
         assert_eq!((e.boundary, e.non_manifold), (0, 0));
@@ -423,7 +423,7 @@ mod tests {
         assert!(stats.zipped >= 1, "{stats:?}");
         faces.extend(&strip);
         assert_eq!(edge_counts(&faces).non_manifold, 0);
-        let (fill, _) = crate::mesh::close_short_holes(&p, &faces, 48);
+        let (fill, _) = crate::mesh::close_short_holes(&p, &faces, 48, &|_| true);
         faces.extend(fill);
         let e = edge_counts(&faces);
         assert_eq!((e.boundary, e.non_manifold), (0, 0));

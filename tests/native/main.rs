@@ -21,6 +21,7 @@ mod fuzz;
 mod gpu_primitives;
 mod layering;
 mod loss_optim;
+mod measured_space;
 mod object_budgets;
 mod object_import;
 mod object_import_errors;

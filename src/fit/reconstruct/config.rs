@@ -75,8 +75,11 @@ pub struct ReconstructionConfig {
     /// After remeshing, a part's connected pieces with fewer faces than this fraction of its
     /// largest piece are dropped as floaters.
     pub min_component_fraction: f32,
-    /// After that, each part's holes bounded by at most this many boundary edges are closed
-    /// (0 = none).
+    /// After that, the static base's holes bounded by at most this many boundary edges are
+    /// closed where its fills are checked against both states' views (measured surfaces), every
+    /// other part's (and an unchecked base's) up to half as many (0 = none): a movable part's
+    /// fills meet only its own state's views (its motion is not known yet), so a drawer's open
+    /// top, hidden in the start state, would close unchecked.
     pub close_holes: usize,
     /// Then boundary runs that stay within this many median edge lengths of another loop's
     /// boundary (a thin part's two sides at its rim) are zipped together (0 = none).
@@ -205,7 +208,7 @@ impl ReconstructionConfig {
             min_component_fraction: 0.05,
             // Quick suite (fast): closing loops up to 48 / 96 edges leaves 3.8 / 1.9 % boundary
             // edges (11.9 % with none); 96 also spans real openings (CD-m 3.61 -> 3.75 mm).
-            close_holes: 48,
+            close_holes: 96,
             rim_gap: 3.0,
             recovery_iterations: budget.recovery_iterations,
             recovery_position_lr: 2e-5,

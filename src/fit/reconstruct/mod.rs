@@ -23,6 +23,7 @@
 mod both;
 mod config;
 mod densify;
+pub mod free_space;
 mod remesh;
 mod results;
 mod state;
@@ -31,11 +32,14 @@ pub use config::{DensifyConfig, ReconstructionConfig, RemeshMode, SurfaceSource}
 pub use results::{PhaseTimes, Reconstruction, RemeshStats, StateReconstruction};
 pub use state::reconstruct_state;
 
+use std::sync::Arc;
+
 use super::views::downsample_frame;
 use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
 use crate::data::{Dataset, Frame, Split, State};
 use crate::fit::observer::Observer;
 use crate::gpu::{GpuContext, GpuError, GpuResult};
+use free_space::FreeSpace;
 
 /// A state of the dataset without training views, so there is nothing to fit.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, thiserror::Error)]
@@ -66,6 +70,9 @@ pub struct StateViews {
     pub measured: Option<ObservedState>,
     /// The clouds its mesh is built over: `measured` with the static base seen in both states.
     pub surface: Option<ObservedState>,
+    /// Where both states' training views saw through (shared by the two states' views): holes
+    /// whose fill it sees through stay open.
+    pub free_space: Option<Arc<FreeSpace>>,
 }
 
 /// The held-out (test) views of `state`, all of them, downsampled as the training views are;
@@ -115,6 +122,11 @@ pub fn state_views(dataset: &Dataset, config: &ReconstructionConfig) -> GpuResul
     let mut measured = measured
         .map(|[s, e]| [Some(s), Some(e)])
         .unwrap_or_default();
+    // Over measured surfaces only (what the suites measured; the optimised surfaces of `tiny` and
+    // `paper` close holes as before).
+    let free_space = (config.surface == SurfaceSource::Measured)
+        .then(|| FreeSpace::from_dataset(dataset).map(Arc::new))
+        .flatten();
     let mut views = |state: State| -> GpuResult<StateViews> {
         Ok(StateViews {
             train: training_views(dataset, state, config)
@@ -122,6 +134,7 @@ pub fn state_views(dataset: &Dataset, config: &ReconstructionConfig) -> GpuResul
             held_out: test_views(dataset, state, config),
             measured: measured[state.index()].take(),
             surface: surface[state.index()].take(),
+            free_space: free_space.clone(),
         })
     };
     Ok([views(State::Start)?, views(State::End)?])

@@ -5,8 +5,10 @@
 use glam::Vec3;
 
 use super::config::{ReconstructionConfig, RemeshMode, SurfaceSource};
+use super::free_space::{FreeSpace, evidence_states};
 use super::results::RemeshStats;
 use crate::articulation::observed::ObservedState;
+use crate::data::State;
 use crate::mesh::topology::{
     compact, cross_part_faces, drop_small_components, face_part, median_edge, thin_vertices,
     vertex_normals,
@@ -27,10 +29,13 @@ const MIN_MEASURED_POINTS: usize = 32;
 const MEASURED_MIN_NORMAL_COSINE: f32 = 0.0;
 
 /// Hardened labels, new faces and what happened, for `field` remeshed with `config`'s mode, over
-/// the `measured` part surfaces where given (see [`SurfaceSource::Measured`]).
+/// the `measured` part surfaces where given (see [`SurfaceSource::Measured`]); a hole is left
+/// open where the training views of `free` saw through its fill (state `state`'s reconstruction).
 pub(super) fn remesh(
     field: &MeshField,
     measured: Option<&ObservedState>,
+    free: Option<&FreeSpace>,
+    state: State,
     config: &ReconstructionConfig,
 ) -> (MeshField, RemeshStats) {
     let parts = harden_parts(field);
@@ -90,7 +95,25 @@ pub(super) fn remesh(
             .filter(|(_, k)| *k)
             .map(|(f, _)| f)
             .collect();
-        fills.extend(close_part(&used.positions, own, config, &mut stats));
+        let states = evidence_states(k as usize, state);
+        let spacing = median_edge(&used.positions, &own);
+        let keep = |face: &[u32; 3]| {
+            free.is_none_or(|f| !f.refuses(&states, &used.positions, face, k as usize, spacing))
+        };
+        // Fills are trusted as far as the views can check them: the static base's against both
+        // states' views, so its loops close up to the limit; every other loop up to half of it.
+        let checked = k == 0 && free.is_some();
+        let max_edges = if checked {
+            config.close_holes
+        } else {
+            config.close_holes / 2
+        };
+        let closing = Closing {
+            max_edges,
+            rim_gap: config.rim_gap,
+            keep: &keep,
+        };
+        fills.extend(close_part(&used.positions, own, &closing, &mut stats));
     }
     stats.floater_faces = keep.iter().filter(|k| !**k).count();
     let faces: Vec<[u32; 3]> = faces
@@ -113,25 +136,36 @@ pub(super) fn remesh(
     (out, stats)
 }
 
+/// How one part's holes and rims are closed.
+struct Closing<'a> {
+    /// Longest hole loop closed (edges).
+    max_edges: usize,
+    /// Rim gap in median edges (0: rims stay open).
+    rim_gap: f32,
+    /// Whether a fill face may stay (the views did not see through it).
+    keep: &'a dyn Fn(&[u32; 3]) -> bool,
+}
+
 /// The faces that close one part's `own` faces: its short holes, then its rims where a thin
 /// part's two sides run side by side, then the short holes the zips left.
 fn close_part(
     positions: &[Vec3],
     mut own: Vec<[u32; 3]>,
-    config: &ReconstructionConfig,
+    closing: &Closing,
     stats: &mut RemeshStats,
 ) -> Vec<[u32; 3]> {
     let kept = own.len();
     let close_holes = |own: &mut Vec<[u32; 3]>, stats: &mut RemeshStats| {
-        let (fill, holes) = close_short_holes(positions, own, config.close_holes);
+        let (fill, holes) = close_short_holes(positions, own, closing.max_edges, closing.keep);
         stats.holes.loops += holes.loops;
         stats.holes.closed += holes.closed;
         stats.holes.faces += holes.faces;
+        stats.holes.refused_faces += holes.refused_faces;
         own.extend(fill);
     };
     close_holes(&mut own, stats);
-    if config.rim_gap > 0.0 && !own.is_empty() {
-        let gap = config.rim_gap * median_edge(positions, &own);
+    if closing.rim_gap > 0.0 && !own.is_empty() {
+        let gap = closing.rim_gap * median_edge(positions, &own);
         let (strip, rims) = stitch_rims(positions, &own, gap);
         stats.rims.zipped += rims.zipped;
         stats.rims.faces += rims.faces;
@@ -275,7 +309,7 @@ mod tests {
             surface: SurfaceSource::Measured,
             ..ReconstructionConfig::preset(crate::fit::preset::Preset::Tiny)
         };
-        let (remeshed, stats) = remesh(&field, Some(&measured), &config);
+        let (remeshed, stats) = remesh(&field, Some(&measured), None, State::Start, &config);
         assert_eq!(stats.cross_part_faces, 0);
         assert!(remeshed.faces.len() > 100, "{} faces", remeshed.faces.len());
     }
@@ -301,8 +335,8 @@ mod tests {
             close_holes,
             ..ReconstructionConfig::preset(crate::fit::preset::Preset::Tiny)
         };
-        let (open, open_stats) = remesh(&field, Some(&measured), &config(0));
-        let (closed, stats) = remesh(&field, Some(&measured), &config(12));
+        let (open, open_stats) = remesh(&field, Some(&measured), None, State::Start, &config(0));
+        let (closed, stats) = remesh(&field, Some(&measured), None, State::Start, &config(12));
         let (open_edges, edges) = (edge_counts(&open.faces), edge_counts(&closed.faces));
         assert_eq!(open_stats.holes.closed, 0);
         // Two loops: the gap's, closed, and the sheet's rim (longer than 12 edges), left open.

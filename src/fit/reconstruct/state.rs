@@ -6,6 +6,7 @@ use super::StateViews;
 use super::config::ReconstructionConfig;
 use super::config::SurfaceSource;
 use super::densify::{densify_and_prune, pixels_per_metre};
+use super::free_space::FreeSpace;
 use super::remesh::{measures_every_part, remesh};
 use super::results::{PhaseTimes, RemeshStats, StateReconstruction};
 use crate::articulation::observed::ObservedState;
@@ -146,7 +147,8 @@ pub async fn reconstruct_state(
         fit.seed,
     )?;
     let optimised = optimise(&mut run, &mut trainer, &field, frames.len(), px_per_m).await?;
-    let (remeshed, remesh_stats) = remesh_stage(&mut run, &optimised.field, measured).await?;
+    let free = views.free_space.as_deref();
+    let (remeshed, remesh_stats) = remesh_stage(&mut run, &optimised.field, measured, free).await?;
     let recovered = recover(&mut run, &mut trainer, &remeshed).await?;
     let recovery = config.recovery();
     let last = recovery.settings_at(recovery.iterations);
@@ -308,8 +310,9 @@ async fn remesh_stage(
     run: &mut StateRun<'_>,
     optimised: &MeshField,
     measured: Option<&ObservedState>,
+    free: Option<&FreeSpace>,
 ) -> GpuResult<(MeshField, RemeshStats)> {
-    let (remeshed, stats) = remesh(optimised, measured, run.config);
+    let (remeshed, stats) = remesh(optimised, measured, free, run.state, run.config);
     if remeshed.faces.is_empty() {
         return Err(run.error(format!(
             "remeshing built no faces from {} vertices",

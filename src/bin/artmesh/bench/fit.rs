@@ -4,10 +4,11 @@
 use std::path::PathBuf;
 use std::time::Instant;
 
-use artmesh::data::Dataset;
 use artmesh::data::degrade::DepthDegradation;
+use artmesh::data::{Dataset, State};
 use artmesh::eval::{
-    BenchmarkTable, ColumnSummary, EvalOptions, MeshSummary, ObjectMetrics, mesh_summary,
+    BenchmarkTable, ColumnSummary, EvalOptions, MeshSummary, ObjectMetrics, StaticBound,
+    mesh_summary, static_bound,
 };
 use artmesh::export::JointRecord;
 use artmesh::fit::articulate::{Ablation, ArticulationConfig, GeometryUse, articulate};
@@ -127,13 +128,23 @@ fn log_object(o: &FitObject) {
         f(m.type_accuracy)
     );
     eprintln!(
-        "bench fit:   meshes: {:.1} % boundary edges on closed parts, {} non-manifold edges, {} cross-part faces, {} split parts, {} holes closed",
+        "bench fit:   meshes: {:.1} % boundary edges on closed parts, {} non-manifold edges, {} cross-part faces, {} split parts, {} holes closed, {} fill faces left out (seen through)",
         100.0 * o.mesh.closed_boundary_fraction(),
         o.mesh.non_manifold_edges,
         o.mesh.cross_part_faces,
         o.mesh.split_parts,
-        o.mesh.holes_closed
+        o.mesh.holes_closed,
+        o.mesh.fill_faces_refused
     );
+    if let (Some(cd), Some(b)) = (m.cd_s, o.cd_s_bound) {
+        eprintln!(
+            "bench fit:   CD-s {:.2} mm; a fit of the seen surface alone scores {:.2} mm (views see {:.0} % of the true base; sampling floor {:.2} mm)",
+            cd.cd_mm,
+            b.seen_only_mm,
+            100.0 * b.seen_share,
+            b.floor_mm
+        );
+    }
     for w in &o.warnings {
         eprintln!("bench fit:   warning: {w}");
     }
@@ -158,6 +169,8 @@ pub struct FitObject {
     pub metrics: ObjectMetrics,
     /// Both states' part meshes: boundary, non-manifold and cross-part counts, split parts.
     pub mesh: MeshSummary,
+    /// What the training views measure of the true static part, and the CD-s bounds that sets.
+    pub cd_s_bound: Option<StaticBound>,
     pub joints: Vec<JointRecord>,
     pub warnings: Vec<String>,
 }
@@ -197,6 +210,7 @@ impl FitBench {
             self.by_category.to_markdown()
         );
         out.push_str(&meshes_markdown(&self.objects));
+        out.push_str(&bounds_markdown(&self.objects));
         if let Some(t) = &self.ablation {
             out.push_str(&format!("\n### Ablations\n\n{}", t.to_markdown()));
         }
@@ -211,9 +225,9 @@ fn meshes_markdown(objects: &[FitObject]) -> String {
         .fold(MeshSummary::default(), |sum, o| sum.plus(&o.mesh));
     format!(
         "\n### Meshes (both states, all objects)\n\n\
-         | Part meshes | Boundary edges | On closed parts | Non-manifold edges | Cross-part faces | Split parts | Holes closed |\n\
-         |---|---|---|---|---|---|---|\n\
-         | {} | {:.1} % | {:.1} % ({} parts) | {} | {} | {} | {} |\n",
+         | Part meshes | Boundary edges | On closed parts | Non-manifold edges | Cross-part faces | Split parts | Holes closed | Fill faces seen through |\n\
+         |---|---|---|---|---|---|---|---|\n\
+         | {} | {:.1} % | {:.1} % ({} parts) | {} | {} | {} | {} | {} |\n",
         m.parts,
         100.0 * m.boundary_edges as f64 / m.edges.max(1) as f64,
         100.0 * m.closed_boundary_fraction(),
@@ -221,7 +235,31 @@ fn meshes_markdown(objects: &[FitObject]) -> String {
         m.non_manifold_edges,
         m.cross_part_faces,
         m.split_parts,
-        m.holes_closed
+        m.holes_closed,
+        m.fill_faces_refused
+    )
+}
+
+/// The fitted CD-s beside what the measurements allow (`eval::seen`), averaged over the objects
+/// that have both, as a Markdown table.
+fn bounds_markdown(objects: &[FitObject]) -> String {
+    let rows: Vec<(f64, StaticBound)> = objects
+        .iter()
+        .filter_map(|o| Some((o.metrics.cd_s.as_ref()?.cd_mm, o.cd_s_bound?)))
+        .collect();
+    let mean = |f: &dyn Fn(&(f64, StaticBound)) -> f64| {
+        rows.iter().map(f).sum::<f64>() / rows.len().max(1) as f64
+    };
+    format!(
+        "\n### CD-s and what the views measure ({} objects)\n\n\
+         | Fitted CD-s mm | Seen-surface bound mm | Sampling floor mm | True static surface seen |\n\
+         |---|---|---|---|\n\
+         | {:.2} | {:.2} | {:.2} | {:.1} % |\n",
+        rows.len(),
+        mean(&|r| r.0),
+        mean(&|r| r.1.seen_only_mm),
+        mean(&|r| r.1.floor_mm),
+        100.0 * mean(&|r| r.1.seen_share),
     )
 }
 
@@ -353,6 +391,7 @@ fn fit_one(
         psnr_test: [0, 1].map(|i| fit.reconstruction.states.get(i).and_then(|s| s.psnr_test)),
         metrics: score(&fit, dataset, object)?,
         mesh: mesh_summary(&fit.reconstruction, &dataset.gt_meshes),
+        cd_s_bound: static_bound(dataset, State::Start, &EvalOptions::default().chamfer),
         joints: artmesh::export::joint_records(&fit),
         warnings: fit.articulation.warnings.clone(),
     };
