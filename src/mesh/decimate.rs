@@ -17,6 +17,8 @@ use std::collections::{BTreeSet, BinaryHeap};
 
 use glam::{DMat4, DVec3, DVec4, Vec3};
 
+use super::topology::{face_edges, undirected};
+
 /// Weight of a rim's constraint planes against the faces' own.
 const RIM_WEIGHT: f64 = 100.0;
 /// A face whose normal turns further than this (cosine) in a collapse blocks it.
@@ -161,8 +163,8 @@ impl Work {
     fn edges(&self) -> BTreeSet<(u32, u32)> {
         self.faces
             .iter()
-            .flat_map(|t| [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])])
-            .map(|(a, b)| (a.min(b), a.max(b)))
+            .flat_map(face_edges)
+            .map(|(a, b)| undirected(a, b))
             .collect()
     }
 

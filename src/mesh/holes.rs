@@ -9,6 +9,8 @@ use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
+use super::topology::{face_edges, undirected};
+
 /// The longest loop [`close_short_holes`] fills: its triangulation takes O(n²) memory and O(n³)
 /// time in the loop's length.
 pub const MAX_HOLE_EDGES: usize = 256;
@@ -87,23 +89,16 @@ fn forget_diagonals(
     edges: &mut HashSet<(u32, u32)>,
 ) {
     let n = hole.len();
-    let face_edges = |f: &[u32; 3]| {
-        let f = *f;
-        (0..3).map(move |i| undirected(f[i], f[(i + 1) % 3]))
-    };
     let own: HashSet<(u32, u32)> = (0..n)
-        .map(|i| undirected(hole[i], hole[(i + 1) % n]))
+        .map(|i| (hole[i], hole[(i + 1) % n]))
         .chain(kept.iter().flat_map(face_edges))
+        .map(|(a, b)| undirected(a, b))
         .collect();
-    for e in left.iter().flat_map(face_edges) {
-        if !own.contains(&e) {
-            edges.remove(&e);
+    for (a, b) in left.iter().flat_map(face_edges) {
+        if !own.contains(&undirected(a, b)) {
+            edges.remove(&undirected(a, b));
         }
     }
-}
-
-pub(super) fn undirected(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
 }
 
 /// A simple boundary loop of a mesh, in its walking order.
@@ -119,15 +114,12 @@ pub(super) fn boundary_loops(faces: &[[u32; 3]]) -> (Vec<BoundaryLoop>, HashSet<
     // Per undirected edge: uses, and the direction of its first face.
     let mut uses: HashMap<(u32, u32), (u32, (u32, u32))> = HashMap::new();
     let mut order = Vec::new(); // edges in order of first use, so the output is deterministic
-    for f in faces {
-        for i in 0..3 {
-            let (a, b) = (f[i], f[(i + 1) % 3]);
-            let e = uses.entry(undirected(a, b)).or_insert_with(|| {
-                order.push(undirected(a, b));
-                (0, (a, b))
-            });
-            e.0 += 1;
-        }
+    for (a, b) in faces.iter().flat_map(face_edges) {
+        let e = uses.entry(undirected(a, b)).or_insert_with(|| {
+            order.push(undirected(a, b));
+            (0, (a, b))
+        });
+        e.0 += 1;
     }
     let boundary: Vec<(u32, u32)> = order.iter().copied().filter(|e| uses[e].0 == 1).collect();
     let loops = simple_loops(&boundary)

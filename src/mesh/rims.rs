@@ -9,8 +9,9 @@ use std::collections::{HashMap, HashSet};
 
 use glam::Vec3;
 
-use super::holes::{BoundaryLoop, boundary_loops, undirected};
+use super::holes::{BoundaryLoop, boundary_loops};
 use super::spatial::KdTree;
+use super::topology::undirected;
 
 /// Runs shorter than this many vertices are not zipped: a few boundary vertices that happen to be
 /// near another loop are not a rim.

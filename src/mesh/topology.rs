@@ -169,14 +169,21 @@ pub struct EdgeCounts {
     pub non_manifold: usize,
 }
 
+/// The three edges of `face`, each as it runs around the face (a→b).
+pub(crate) fn face_edges(face: &[u32; 3]) -> [(u32, u32); 3] {
+    [(face[0], face[1]), (face[1], face[2]), (face[2], face[0])]
+}
+
+/// The edge between `a` and `b` whichever way it runs: the key of per-edge maps.
+pub(crate) fn undirected(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
 /// Counts the edges of `faces` by how many faces use them.
 pub fn edge_counts(faces: &[[u32; 3]]) -> EdgeCounts {
     let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
-    for f in faces {
-        for i in 0..3 {
-            let (a, b) = (f[i], f[(i + 1) % 3]);
-            *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-        }
+    for (a, b) in faces.iter().flat_map(face_edges) {
+        *uses.entry(undirected(a, b)).or_default() += 1;
     }
     EdgeCounts {
         edges: uses.len(),
@@ -264,7 +271,7 @@ pub(crate) fn longest_edge(positions: &[Vec3], face: &[u32; 3]) -> f32 {
 pub(crate) fn median_edge(positions: &[Vec3], faces: &[[u32; 3]]) -> f32 {
     let mut lengths: Vec<f32> = faces
         .iter()
-        .flat_map(|f| (0..3).map(move |i| (f[i], f[(i + 1) % 3])))
+        .flat_map(face_edges)
         .map(|(a, b)| positions[a as usize].distance(positions[b as usize]))
         .collect();
     if lengths.is_empty() {

@@ -206,8 +206,9 @@ impl ReconstructionConfig {
             },
             remesh_spacing: 1.5,
             min_component_fraction: 0.05,
-            // Quick suite (fast): closing loops up to 48 / 96 edges leaves 3.8 / 1.9 % boundary
-            // edges (11.9 % with none); 96 also spans real openings (CD-m 3.61 -> 3.75 mm).
+            // Quick suite (fast), fills checked against the views: 96 on the base (48 elsewhere)
+            // against 48 everywhere, CD-s 9.83 -> 9.51 mm, boundary edges 1.63 -> 1.28 %; 96
+            // everywhere closed drawers' open tops (CD-m 3.47 -> 3.64 mm). docs/results.md.
             close_holes: 96,
             rim_gap: 3.0,
             recovery_iterations: budget.recovery_iterations,

@@ -70,8 +70,8 @@ pub struct StateViews {
     pub measured: Option<ObservedState>,
     /// The clouds its mesh is built over: `measured` with the static base seen in both states.
     pub surface: Option<ObservedState>,
-    /// Where both states' training views saw through (shared by the two states' views): holes
-    /// whose fill it sees through stay open.
+    /// Where both states' training views saw through (shared by the two states' views): hole-fill
+    /// faces it sees through are left out.
     pub free_space: Option<Arc<FreeSpace>>,
 }
 

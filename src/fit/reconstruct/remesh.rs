@@ -29,8 +29,8 @@ const MIN_MEASURED_POINTS: usize = 32;
 const MEASURED_MIN_NORMAL_COSINE: f32 = 0.0;
 
 /// Hardened labels, new faces and what happened, for `field` remeshed with `config`'s mode, over
-/// the `measured` part surfaces where given (see [`SurfaceSource::Measured`]); a hole is left
-/// open where the training views of `free` saw through its fill (state `state`'s reconstruction).
+/// the `measured` part surfaces where given (see [`SurfaceSource::Measured`]); hole-fill faces
+/// the training views of `free` saw through are left out (state `state`'s reconstruction).
 pub(super) fn remesh(
     field: &MeshField,
     measured: Option<&ObservedState>,
