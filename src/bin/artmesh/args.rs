@@ -112,8 +112,8 @@ pub struct BudgetArgs {
     #[arg(long, value_parser = ["measured", "optimised"])]
     surface: Option<String>,
     /// After remeshing, close the static base's holes bounded by at most this many edges where the
-    /// depth maps check its fills (measured surfaces), every other part's bounded by half as many;
-    /// fill faces the views saw through are left out (0: none, at most 256) [default: 96].
+    /// depth maps check its fills (measured surfaces), every other part's by at most 48; fill
+    /// faces the views saw through are left out (0: none, at most 256) [default: 256].
     #[arg(long)]
     close_holes: Option<usize>,
     /// Then zip a thin part's two sides together where their rims stay within this many median

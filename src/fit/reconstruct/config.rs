@@ -6,7 +6,13 @@ use serde::Serialize;
 use crate::fit::init::InitOptions;
 use crate::fit::photometric::PhotometricConfig;
 use crate::fit::preset::{Budget, Preset};
-use crate::mesh::RemeshOptions;
+use crate::mesh::{MAX_HOLE_EDGES, RemeshOptions};
+
+/// The longest hole loop closed where no view can check the fill: a movable part's (its fills
+/// meet only its own state's views, and its motion is not known yet, so a drawer's open top,
+/// hidden in the start state, would close unchecked) and a base's over optimised surfaces.
+/// Quick suite: 96 on every part closed drawers' tops, CD-m 3.47 -> 3.64 mm (docs/results.md).
+pub const UNCHECKED_HOLE_EDGES: usize = 48;
 
 /// How faces are rebuilt after hardening.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -75,11 +81,10 @@ pub struct ReconstructionConfig {
     /// After remeshing, a part's connected pieces with fewer faces than this fraction of its
     /// largest piece are dropped as floaters.
     pub min_component_fraction: f32,
-    /// After that, the static base's holes bounded by at most this many boundary edges are
-    /// closed where its fills are checked against both states' views (measured surfaces), every
-    /// other part's (and an unchecked base's) up to half as many (0 = none): a movable part's
-    /// fills meet only its own state's views (its motion is not known yet), so a drawer's open
-    /// top, hidden in the start state, would close unchecked.
+    /// After that, the static base's holes bounded by at most this many boundary edges (at most
+    /// [`MAX_HOLE_EDGES`]) are closed where its fills are checked against both states' views
+    /// (measured surfaces), every other part's (and an unchecked base's) up to
+    /// [`UNCHECKED_HOLE_EDGES`] (0 = none).
     pub close_holes: usize,
     /// Then boundary runs that stay within this many median edge lengths of another loop's
     /// boundary (a thin part's two sides at its rim) are zipped together (0 = none).
@@ -206,10 +211,10 @@ impl ReconstructionConfig {
             },
             remesh_spacing: 1.5,
             min_component_fraction: 0.05,
-            // Quick suite (fast), fills checked against the views: 96 on the base (48 elsewhere)
-            // against 48 everywhere, CD-s 9.83 -> 9.51 mm, boundary edges 1.63 -> 1.28 %; 96
-            // everywhere closed drawers' open tops (CD-m 3.47 -> 3.64 mm). docs/results.md.
-            close_holes: 96,
+            // Quick suite (fast), fills checked against the views: 96 on the base against 48,
+            // CD-s 9.83 -> 9.51 mm; every loop the fill takes (256) against 96, 9.18 -> 8.92 mm
+            // (holdout 12.22 -> 11.80 mm): open undersides close. docs/results.md.
+            close_holes: MAX_HOLE_EDGES,
             rim_gap: 3.0,
             recovery_iterations: budget.recovery_iterations,
             recovery_position_lr: 2e-5,

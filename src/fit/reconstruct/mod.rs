@@ -28,7 +28,9 @@ mod remesh;
 mod results;
 mod state;
 
-pub use config::{DensifyConfig, ReconstructionConfig, RemeshMode, SurfaceSource};
+pub use config::{
+    DensifyConfig, ReconstructionConfig, RemeshMode, SurfaceSource, UNCHECKED_HOLE_EDGES,
+};
 pub use results::{PhaseTimes, Reconstruction, RemeshStats, StateReconstruction};
 pub use state::reconstruct_state;
 

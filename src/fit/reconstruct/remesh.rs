@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::config::{ReconstructionConfig, RemeshMode, SurfaceSource};
+use super::config::{ReconstructionConfig, RemeshMode, SurfaceSource, UNCHECKED_HOLE_EDGES};
 use super::free_space::{FreeSpace, evidence_states};
 use super::results::RemeshStats;
 use crate::articulation::observed::ObservedState;
@@ -101,12 +101,12 @@ pub(super) fn remesh(
             free.is_none_or(|f| !f.refuses(&states, &used.positions, face, k as usize, spacing))
         };
         // Fills are trusted as far as the views can check them: the static base's against both
-        // states' views, so its loops close up to the limit; every other loop up to half of it.
+        // states' views, so its loops close up to the limit; every other loop stays short.
         let checked = k == 0 && free.is_some();
         let max_edges = if checked {
             config.close_holes
         } else {
-            config.close_holes / 2
+            config.close_holes.min(UNCHECKED_HOLE_EDGES)
         };
         let closing = Closing {
             max_edges,
@@ -245,7 +245,7 @@ mod tests {
 
     use super::*;
     use crate::articulation::observed::PartCloud;
-    use crate::mesh::edge_counts;
+    use crate::mesh::{MAX_HOLE_EDGES, edge_counts};
 
     /// A flat square of `n`² points at height `z`, normals up.
     fn square(n: usize, z: f32) -> PartCloud {
@@ -353,5 +353,25 @@ mod tests {
         assert!(edges.boundary > 12, "{edges:?}");
         assert_eq!(edges.non_manifold, 0);
         assert_eq!(closed.faces.len(), open.faces.len() + stats.holes.faces);
+    }
+
+    #[test]
+    fn with_no_views_to_check_fills_a_loop_stays_open_past_the_unchecked_limit() {
+        let field = MeshField::new(vec![Vec3::ZERO; 3], Vec::new(), 1, 0.0);
+        let measured = ObservedState {
+            parts: vec![square(48, 0.0)],
+            views_with_depth: 1,
+            views: 1,
+            stride: 1,
+        };
+        let config = ReconstructionConfig {
+            surface: SurfaceSource::Measured,
+            close_holes: MAX_HOLE_EDGES,
+            ..ReconstructionConfig::preset(crate::fit::preset::Preset::Tiny)
+        };
+        let (sheet, stats) = remesh(&field, Some(&measured), None, State::Start, &config);
+        let rim = edge_counts(&sheet.faces).boundary;
+        assert!(rim > UNCHECKED_HOLE_EDGES, "{rim}");
+        assert_eq!((stats.holes.loops, stats.holes.closed), (1, 0));
     }
 }
