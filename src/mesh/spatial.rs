@@ -143,3 +143,37 @@ fn build(entries: &mut [(Vec3, u32)], axis: &mut [u8], lo: usize, hi: usize) {
     build(entries, axis, lo, m);
     build(entries, axis, m + 1, hi);
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::rng::Rng;
+
+    #[test]
+    fn filtered_queries_near_a_surface_match_brute_force() {
+        // Points on a wavy sheet (as the registration's clouds are), queried just off it.
+        let mut rng = Rng::new(3);
+        let sheet = |u: f32, v: f32| Vec3::new(u, v, 0.05 * (6.0 * u).sin());
+        let pts: Vec<Vec3> = (0..3000)
+            .map(|_| sheet(rng.next_f32(), rng.next_f32()))
+            .collect();
+        let tree = KdTree::new(&pts);
+        for _ in 0..300 {
+            let q = sheet(rng.next_f32(), rng.next_f32()) + Vec3::Z * (rng.next_f32() - 0.5) * 0.1;
+            let odd = |i: usize| i % 2 == 1;
+            let brute = |keep: &dyn Fn(usize) -> bool| {
+                (0..pts.len())
+                    .filter(|&i| keep(i))
+                    .map(|i| q.as_dvec3().distance_squared(pts[i].as_dvec3()))
+                    .fold(f64::INFINITY, f64::min)
+            };
+            assert_eq!(
+                tree.nearest_index(q).map(|(_, d2)| d2),
+                Some(brute(&|_| true))
+            );
+            let (i, d2) = tree.nearest_index_where(q, odd).unwrap();
+            assert!(odd(i));
+            assert_eq!(d2, brute(&odd));
+        }
+    }
+}
