@@ -19,6 +19,7 @@ import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 import { checkSharedObjectFit, checkUrdfZip } from "./urdf.mjs";
 import { checkResultViewer } from "./result.mjs";
+import { changed, snapshot } from "./canvas.mjs";
 import { checkMobileAndTouch } from "./touch.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
@@ -356,10 +357,6 @@ try {
 
   // 4b. true and fitted axes, read off the viewer's pixels ---------------------------------
   await step("true and fitted axes", async () => {
-    const pixels = () => page.evaluate(() => {
-      const c = document.getElementById("viewer");
-      return Array.from(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
-    });
     const toggle = async (id, on) => {
       await page.evaluate(([id, on]) => {
         const el = document.getElementById(id);
@@ -371,24 +368,16 @@ try {
     if (!check(await page.locator("#show-truth-label").isVisible(), "the true-axes toggle is offered for the demo")) return;
     await toggle("show-axes", true);
     await toggle("show-truth", true);
-    const both = await pixels();
+    const both = await snapshot(page);
     await toggle("show-truth", false);
-    const fitted = await pixels();
+    const fitted = await snapshot(page);
     await toggle("show-axes", false);
-    const none = await pixels();
+    const none = await snapshot(page);
     await toggle("show-axes", true);
     await toggle("show-truth", true);
     // Pixels that change when a set of axes goes: dark ones for the truth, coloured ones for the fit.
-    const changed = (a, b, keep) => {
-      let n = 0;
-      for (let i = 0; i < a.length; i += 4) {
-        if (Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) > 60 &&
-          keep(a[i], a[i + 1], a[i + 2])) n++;
-      }
-      return n;
-    };
-    const dark = changed(both, fitted, (r, g, b) => Math.max(r, g, b) < 70);
-    const coloured = changed(fitted, none, (r, g, b) => Math.max(r, g, b) - Math.min(r, g, b) > 80);
+    const dark = await changed(page, both, fitted, { threshold: 60, darkBelow: 70 });
+    const coloured = await changed(page, fitted, none, { threshold: 60, colourAbove: 80 });
     check(dark > 30, `the true axes are drawn, in black (${dark} dark pixels go with them)`);
     check(coloured > 30, `the fitted axes are drawn, in colour (${coloured} coloured pixels go with them)`);
   });

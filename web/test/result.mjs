@@ -4,42 +4,7 @@
 // colours, the wasm palette's, found in the picture), the true parts' overlay (changes the
 // picture, and off restores it) and the opening view's score; no console errors meanwhile.
 import { writeFile } from "node:fs/promises";
-
-// Canvas reads stay in the page (copying a canvas out to node took most of a minute over the
-// checks); node holds snapshot ids.
-
-/** Keeps a copy of the viewer canvas's RGBA bytes in the page; its id. */
-const pixels = (page) => page.evaluate(() => {
-  const c = document.getElementById("viewer");
-  const snaps = (window.__viewerSnaps ||= []);
-  snaps.push(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
-  return snaps.length - 1;
-});
-
-/** Pixels that differ by more than a little between two snapshots (ids from `pixels`). */
-const changed = (page, a, b) => page.evaluate(([a, b]) => {
-  [a, b] = [window.__viewerSnaps[a], window.__viewerSnaps[b]];
-  if (a.length !== b.length) return Infinity;
-  let n = 0;
-  for (let i = 0; i < a.length; i += 4) {
-    if (Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) +
-      Math.abs(a[i + 3] - b[i + 3]) > 12) n++;
-  }
-  return n;
-}, [a, b]);
-
-/** Reads the canvas until two reads `gap` ms apart agree (draws in flight have landed); the
- * last difference seen, 0 when it settled. */
-async function settle(page, gap = 900, tries = 5) {
-  let last = await pixels(page), diff = Infinity;
-  for (let i = 0; i < tries && diff > 0; i++) {
-    await page.waitForTimeout(gap);
-    const now = await pixels(page);
-    diff = await changed(page, last, now);
-    last = now;
-  }
-  return { diff, image: last };
-}
+import { changed, settle, snapshot } from "./canvas.mjs";
 
 const pressed = (page) => page.getAttribute("#play", "aria-pressed");
 
@@ -77,7 +42,7 @@ async function checkPlay(page, check) {
   let previous = before;
   for (let i = 0; i < 8 && moving < 2; i++) {
     await page.waitForTimeout(700);
-    const now = await pixels(page);
+    const now = await snapshot(page);
     const diff = await changed(page, previous, now);
     if (diff > 50) { moving++; frames.push(diff); }
     previous = now;

@@ -4,6 +4,7 @@
 // scroll meanwhile. Touches are real input events sent through the DevTools protocol
 // (Input.dispatchTouchEvent), so they travel the browser's own touch → pointer event path.
 import { join } from "node:path";
+import { changed, covered, settle } from "./canvas.mjs";
 
 const PHONE = { width: 390, height: 844 };
 
@@ -65,43 +66,6 @@ async function checkPhonePages({ browser, url, check, native, work, artefacts, w
   }
 }
 
-/** The viewer canvas's RGBA bytes. */
-const pixels = (page) => page.evaluate(() => {
-  const c = document.getElementById("viewer");
-  return Array.from(c.getContext("2d").getImageData(0, 0, c.width, c.height).data);
-});
-
-/** Pixels that differ by more than a little between two reads. */
-function changed(a, b) {
-  if (a.length !== b.length) return Infinity;
-  let n = 0;
-  for (let i = 0; i < a.length; i += 4) {
-    if (Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) > 12) n++;
-  }
-  return n;
-}
-
-/** Pixels unlike the top-left corner's (the background): the twin's size on the canvas. */
-function covered(p) {
-  let n = 0;
-  for (let i = 0; i < p.length; i += 4) {
-    if (Math.abs(p[i] - p[0]) + Math.abs(p[i + 1] - p[1]) + Math.abs(p[i + 2] - p[2]) > 30) n++;
-  }
-  return n;
-}
-
-/** Reads the canvas until two reads `gap` ms apart agree (draws in flight have landed). */
-async function settle(page, gap = 700, tries = 6) {
-  let last = await pixels(page), diff = Infinity;
-  for (let i = 0; i < tries && diff > 0; i++) {
-    await page.waitForTimeout(gap);
-    const now = await pixels(page);
-    diff = changed(last, now);
-    last = now;
-  }
-  return last;
-}
-
 /** One touch gesture: fingers from `from` to `to` (arrays of [x, y]) in `steps` moves. */
 async function gesture(cdp, from, to, steps = 8) {
   const at = (k) => from.map(([x, y], id) => ({ id, x: x + ((to[id][0] - x) * k) / steps, y: y + ((to[id][1] - y) * k) / steps }));
@@ -127,26 +91,26 @@ async function checkViewerTouch(page, cdp, check) {
   const [cx, cy] = [box.x + box.width / 2, box.y + box.height / 2];
   const scrollY = () => page.evaluate(() => window.scrollY);
 
-  const before = await settle(page);
+  const before = (await settle(page, 700, 6)).image;
   const y0 = await scrollY();
   // Mostly upwards: on the page outside the canvas this finger would scroll it.
   await gesture(cdp, [[cx - 40, cy + 60]], [[cx + 60, cy - 60]]);
-  const dragged = await settle(page);
+  const dragged = (await settle(page, 700, 6)).image;
   const moves = await page.evaluate(() => ({ ...window.artmeshTouches }));
   const touchMoves = Object.entries(moves).filter(([k]) => k.startsWith("touch:"));
   check(touchMoves.length === 1, `a one-finger drag reaches the canvas as touch pointer events (${JSON.stringify(moves)})`);
-  const drag = changed(before, dragged);
+  const drag = await changed(page, before, dragged);
   check(drag > 200, `a one-finger drag orbits the twin (${drag} pixels changed)`);
   const y1 = await scrollY();
   check(y1 === y0, `the page does not scroll while dragging on the viewer (scrollY ${y0} → ${y1})`);
 
   await page.evaluate(() => { window.artmeshTouches = {}; });
-  const small = covered(dragged);
+  const small = await covered(page, dragged);
   // Two fingers moving apart, horizontally about the centre: zoom in.
   await gesture(cdp, [[cx - 25, cy], [cx + 25, cy]], [[cx - 110, cy + 10], [cx + 110, cy - 10]]);
-  const pinched = await settle(page);
+  const pinched = (await settle(page, 700, 6)).image;
   const fingers = await page.evaluate(() => Object.keys(window.artmeshTouches).filter((k) => k.startsWith("touch:")).length);
-  const pinch = changed(dragged, pinched), large = covered(pinched);
+  const pinch = await changed(page, dragged, pinched), large = await covered(page, pinched);
   check(fingers === 2 && pinch > 200, `a two-finger pinch changes the picture (${fingers} fingers, ${pinch} pixels changed)`);
   check(large > small * 1.3, `pinching out zooms in: the twin covers ${small} → ${large} pixels`);
   const y2 = await scrollY();
@@ -154,7 +118,7 @@ async function checkViewerTouch(page, cdp, check) {
     `visual scale ${await page.evaluate(() => window.visualViewport?.scale ?? 1)})`);
   // Fingers together again: zoom back out, so later steps see the twin as before.
   await gesture(cdp, [[cx - 110, cy], [cx + 110, cy]], [[cx - 25, cy], [cx + 25, cy]]);
-  const back = covered(await settle(page));
+  const back = await covered(page, (await settle(page, 700, 6)).image);
   check(back < large, `pinching in zooms back out (the twin covers ${large} → ${back} pixels)`);
 }
 
