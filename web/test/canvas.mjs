@@ -11,25 +11,25 @@ export const snapshot = (page) => page.evaluate(() => {
 });
 
 /**
- * Pixels whose RGBA differs by more than `threshold` (summed over the channels) between snapshots
- * `a` and `b`; with `darkBelow`, only those whose brightest channel in `a` is under it; with
- * `colourAbove`, only those whose channels in `a` spread more than it. Infinity when the sizes
- * differ.
+ * Pixels whose RGBA (RGB with `alpha` false) differs by more than `threshold` (summed over the
+ * channels) between snapshots `a` and `b`; with `darkBelow`, only those whose brightest channel in
+ * `a` is under it; with `colourAbove`, only those whose channels in `a` spread more than it.
+ * Infinity when the sizes differ.
  */
-export const changed = (page, a, b, { threshold = 12, darkBelow = Infinity, colourAbove = -1 } = {}) =>
-  page.evaluate(([a, b, threshold, darkBelow, colourAbove]) => {
+export const changed = (page, a, b, { threshold = 12, alpha = true, darkBelow = Infinity, colourAbove = -1 } = {}) =>
+  page.evaluate(([a, b, threshold, alpha, darkBelow, colourAbove]) => {
     [a, b] = [window.__viewerSnaps[a], window.__viewerSnaps[b]];
     if (a.length !== b.length) return Infinity;
     let n = 0;
     for (let i = 0; i < a.length; i += 4) {
       const d = Math.abs(a[i] - b[i]) + Math.abs(a[i + 1] - b[i + 1]) + Math.abs(a[i + 2] - b[i + 2]) +
-        Math.abs(a[i + 3] - b[i + 3]);
+        (alpha ? Math.abs(a[i + 3] - b[i + 3]) : 0);
       if (d <= threshold) continue;
       const hi = Math.max(a[i], a[i + 1], a[i + 2]), lo = Math.min(a[i], a[i + 1], a[i + 2]);
       if (hi < darkBelow && hi - lo > colourAbove) n++;
     }
     return n;
-  }, [a, b, threshold, darkBelow, colourAbove]);
+  }, [a, b, threshold, alpha, darkBelow, colourAbove]);
 
 /** Pixels of snapshot `id` unlike its top-left corner's (the background): the twin's size. */
 export const covered = (page, id) => page.evaluate((id) => {

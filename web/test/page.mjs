@@ -376,8 +376,8 @@ try {
     await toggle("show-axes", true);
     await toggle("show-truth", true);
     // Pixels that change when a set of axes goes: dark ones for the truth, coloured ones for the fit.
-    const dark = await changed(page, both, fitted, { threshold: 60, darkBelow: 70 });
-    const coloured = await changed(page, fitted, none, { threshold: 60, colourAbove: 80 });
+    const dark = await changed(page, both, fitted, { threshold: 60, alpha: false, darkBelow: 70 });
+    const coloured = await changed(page, fitted, none, { threshold: 60, alpha: false, colourAbove: 80 });
     check(dark > 30, `the true axes are drawn, in black (${dark} dark pixels go with them)`);
     check(coloured > 30, `the fitted axes are drawn, in colour (${coloured} coloured pixels go with them)`);
   });

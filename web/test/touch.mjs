@@ -99,7 +99,7 @@ async function checkViewerTouch(page, cdp, check) {
   const moves = await page.evaluate(() => ({ ...window.artmeshTouches }));
   const touchMoves = Object.entries(moves).filter(([k]) => k.startsWith("touch:"));
   check(touchMoves.length === 1, `a one-finger drag reaches the canvas as touch pointer events (${JSON.stringify(moves)})`);
-  const drag = await changed(page, before, dragged);
+  const drag = await changed(page, before, dragged, { alpha: false });
   check(drag > 200, `a one-finger drag orbits the twin (${drag} pixels changed)`);
   const y1 = await scrollY();
   check(y1 === y0, `the page does not scroll while dragging on the viewer (scrollY ${y0} → ${y1})`);
@@ -110,7 +110,7 @@ async function checkViewerTouch(page, cdp, check) {
   await gesture(cdp, [[cx - 25, cy], [cx + 25, cy]], [[cx - 110, cy + 10], [cx + 110, cy - 10]]);
   const pinched = (await settle(page, 700, 6)).image;
   const fingers = await page.evaluate(() => Object.keys(window.artmeshTouches).filter((k) => k.startsWith("touch:")).length);
-  const pinch = await changed(page, dragged, pinched), large = await covered(page, pinched);
+  const pinch = await changed(page, dragged, pinched, { alpha: false }), large = await covered(page, pinched);
   check(fingers === 2 && pinch > 200, `a two-finger pinch changes the picture (${fingers} fingers, ${pinch} pixels changed)`);
   check(large > small * 1.3, `pinching out zooms in: the twin covers ${small} → ${large} pixels`);
   const y2 = await scrollY();

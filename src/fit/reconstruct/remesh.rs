@@ -95,14 +95,20 @@ pub(super) fn remesh(
             .filter(|(_, k)| *k)
             .map(|(f, _)| f)
             .collect();
-        let states = evidence_states(k as usize, state);
-        let spacing = median_edge(&used.positions, &own);
+        // The views that check this part's fills, and its median edge (the evidence's margin);
+        // without free space nothing is checked.
+        let check = free.map(|f| {
+            let states = evidence_states(k as usize, state);
+            (f, states, median_edge(&used.positions, &own))
+        });
         let keep = |face: &[u32; 3]| {
-            free.is_none_or(|f| !f.refuses(&states, &used.positions, face, k as usize, spacing))
+            check.as_ref().is_none_or(|(f, states, spacing)| {
+                !f.refuses(states, &used.positions, face, k as usize, *spacing)
+            })
         };
         // Fills are trusted as far as the views can check them: the static base's against both
         // states' views, so its loops close up to the limit; every other loop stays short.
-        let checked = k == 0 && free.is_some();
+        let checked = k == 0 && check.is_some();
         let max_edges = if checked {
             config.close_holes
         } else {
