@@ -42,6 +42,14 @@ impl Rng {
         lo + self.below(hi.saturating_sub(lo) as u32 + 1) as usize
     }
 
+    /// A standard normal draw (Box–Muller on two uniforms; within ±5.8 σ).
+    pub(crate) fn normal(&mut self) -> f32 {
+        // 1 − u lies in (0, 1], so the logarithm stays finite.
+        let u = 1.0 - self.next_f32();
+        let v = self.next_f32();
+        (-2.0 * u.ln()).sqrt() * (std::f32::consts::TAU * v).cos()
+    }
+
     /// True with probability `p`.
     pub(crate) fn chance(&mut self, p: f32) -> bool {
         self.next_f32() < p

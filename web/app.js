@@ -209,12 +209,13 @@ function readDemoForm() {
   let seed = Math.round(Number($("demo-seed").value));
   if (!Number.isFinite(seed) || seed < 0) seed = 0;
   $("demo-seed").value = String(seed);
-  return { category: $("demo-category").value, parts: n, preset: $("demo-preset").value, seed };
+  return { category: $("demo-category").value, parts: n, preset: $("demo-preset").value, seed,
+    sensor: $("demo-sensor").value };
 }
 
 async function runDemo() {
   if (busy || broken) return;
-  const { category, parts, preset, seed } = readDemoForm();
+  const { category, parts, preset, seed, sensor } = readDemoForm();
   const status = $("demo-status");
   let budget;
   try {
@@ -240,7 +241,7 @@ async function runDemo() {
         if (!p || !(p.total > 0)) return;
         progress.value = p.done / p.total;
         status.textContent = `Photographing the object: ${p.done} of ${p.total} views rendered.`;
-      }, budget);
+      }, budget, sensor);
     } catch (e) {
       document.body.dataset.demo = "error";
       status.textContent = `The demo object could not be made: ${errorText(e)}`;

@@ -218,6 +218,16 @@ const SAME_FIT: f64 = 0.002;
 /// Seeds both candidates of a part seen as `start` (state t₁ vertices) and `end` (state t₂);
 /// `None` when either state has fewer than 3 vertices of the part.
 pub(crate) fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCandidates> {
+    initial_hypotheses(start, end).map(|(c, _)| c)
+}
+
+/// [`initial_candidates`], and every registration from the principal frames' flips read as a
+/// revolute motion: a flat part (a door slab) registers about as well turned over, and each of
+/// those is a hypothesis the measurements must rule out.
+pub(crate) fn initial_hypotheses(
+    start: &[Vec3],
+    end: &[Vec3],
+) -> Option<(JointCandidates, Vec<PartMotion>)> {
     let f1 = principal_frame(start)?;
     let f2 = principal_frame(end)?;
     let tree = KdTree::new(end);
@@ -243,6 +253,10 @@ pub(crate) fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCa
         };
         icp(start, &tree, reg, true)
     });
+    let turns: Vec<PartMotion> = registrations
+        .iter()
+        .map(|r| revolute_of(r, &f1, start))
+        .collect();
     // Symmetric parts (a door slab) register equally well turned by 180°: among the registrations
     // that fit about as well as the best, take the smallest rotation — joints rarely turn further.
     let best = registrations
@@ -273,51 +287,50 @@ pub(crate) fn initial_candidates(start: &[Vec3], end: &[Vec3]) -> Option<JointCa
         icp(start, &tree, reg, false)
     })
     .min_by(|a, b| a.residual.total_cmp(&b.residual))?;
+    let still = Registration {
+        rotation: DQuat::IDENTITY,
+        translation: DVec3::ZERO,
+        residual: 0.0,
+    };
+    let candidates = JointCandidates {
+        revolute: revolute_of(&registration, &f1, start),
+        prismatic: PartMotion::prismatic(slide.translation),
+        registration,
+        prismatic_residual: slide.residual,
+        identity_residual: matches(start, &tree, &still).0,
+    };
+    Some((candidates, turns))
+}
 
+/// The revolute motion nearest a rigid registration of `start` (principal frame `f1`).
+fn revolute_of(registration: &Registration, f1: &PrincipalFrame, start: &[Vec3]) -> PartMotion {
     let (axis, angle) = rotation_axis_angle(registration.rotation);
     let radius = start
         .iter()
         .map(|p| (p.as_dvec3() - f1.centroid).length())
         .fold(0.0, f64::max);
-    let revolute = if angle < MIN_ANGLE {
+    if angle < MIN_ANGLE {
         // No measurable rotation: the largest principal axis through the centroid, a small angle.
-        PartMotion::revolute(f1.axes.col(0), f1.centroid, MIN_ANGLE)
-    } else {
-        // Points P on the axis satisfy t = (I − R) P; least squares near the centroid, then the
-        // point of that axis line closest to the centroid, kept within the part's reach so a
-        // far-away axis cannot imitate a translation.
-        let r = DMat3::from_quat(registration.rotation);
-        let a = DMat3::IDENTITY - r;
-        let lhs = a.transpose() * a + DMat3::from_diagonal(DVec3::splat(1e-9));
-        let rhs = a.transpose() * (registration.translation - a * f1.centroid);
-        let p = f1.centroid + lhs.inverse() * rhs;
-        let mut pivot = closest_on_line(p, axis, f1.centroid);
-        let off = pivot - f1.centroid;
-        if off.length() > radius {
-            pivot = f1.centroid + off * (radius / off.length());
-        }
-        PartMotion {
-            rotation: registration.rotation,
-            pivot,
-            translation: DVec3::ZERO,
-        }
-    };
-    Some(JointCandidates {
-        revolute,
-        prismatic: PartMotion::prismatic(slide.translation),
-        registration,
-        prismatic_residual: slide.residual,
-        identity_residual: matches(
-            start,
-            &tree,
-            &Registration {
-                rotation: DQuat::IDENTITY,
-                translation: DVec3::ZERO,
-                residual: 0.0,
-            },
-        )
-        .0,
-    })
+        return PartMotion::revolute(f1.axes.col(0), f1.centroid, MIN_ANGLE);
+    }
+    // Points P on the axis satisfy t = (I − R) P; least squares near the centroid, then the
+    // point of that axis line closest to the centroid, kept within the part's reach so a
+    // far-away axis cannot imitate a translation.
+    let r = DMat3::from_quat(registration.rotation);
+    let a = DMat3::IDENTITY - r;
+    let lhs = a.transpose() * a + DMat3::from_diagonal(DVec3::splat(1e-9));
+    let rhs = a.transpose() * (registration.translation - a * f1.centroid);
+    let p = f1.centroid + lhs.inverse() * rhs;
+    let mut pivot = closest_on_line(p, axis, f1.centroid);
+    let off = pivot - f1.centroid;
+    if off.length() > radius {
+        pivot = f1.centroid + off * (radius / off.length());
+    }
+    PartMotion {
+        rotation: registration.rotation,
+        pivot,
+        translation: DVec3::ZERO,
+    }
 }
 
 #[cfg(test)]

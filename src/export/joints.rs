@@ -6,6 +6,7 @@ use serde::Serialize;
 
 use crate::articulation::axis_registration::AxisRegistration;
 use crate::data::JointKind;
+use crate::fit::articulate::Ambiguity;
 use crate::fit::object::ObjectFit;
 use crate::object::part_joint;
 
@@ -35,9 +36,13 @@ pub struct JointRecord {
     /// What decided the type and motion (`geometry`, `bake-off+refined`, …).
     pub decided_by: &'static str,
     /// The joint measured from the full-resolution depth and part maps: residuals (mm) of
-    /// both models and of not moving, and the type call's margin (flagged under 0.5).
+    /// both models and of not moving, the evidence between them, and whether it settled.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub geometry: Option<GeometryRecord>,
+    /// The strongest alternative the evidence could not rule out, and how far behind it is;
+    /// absent when every alternative was ruled out.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub ambiguity: Option<Ambiguity>,
     /// Why the joint should be checked by hand; absent when nothing is known to be wrong.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub flag: Option<String>,
@@ -50,7 +55,19 @@ pub struct JointRecord {
 pub struct GeometryRecord {
     #[serde(rename = "type")]
     pub kind: JointKind,
+    /// The weakest evidence of the measured motion over any alternative, in units of the
+    /// decisive level (under 1: an alternative was not ruled out).
     pub margin: f64,
+    /// The evidence (a paired z) of the revolute model over the prismatic one.
+    pub type_evidence: f64,
+    /// The residual (mm) a correct motion of this part is expected to leave, estimated from the
+    /// depth maps (absent: too little of the static base to tell).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub noise_mm: Option<f64>,
+    /// Whether the best model's residual is within the expected one.
+    pub explained: bool,
+    /// Whether the depth maps alone settled the joint.
+    pub settled: bool,
     pub revolute_residual_mm: f64,
     pub prismatic_residual_mm: f64,
     pub identity_residual_mm: f64,
@@ -82,12 +99,17 @@ pub fn joint_records(fit: &ObjectFit) -> Vec<JointRecord> {
                 geometry: j.geometry.map(|g| GeometryRecord {
                     kind: g.kind,
                     margin: g.margin,
+                    type_evidence: g.type_evidence,
+                    noise_mm: g.noise.map(|n| 1000.0 * n),
+                    explained: g.explained,
+                    settled: g.settled(),
                     revolute_residual_mm: 1000.0 * g.revolute_residual,
                     prismatic_residual_mm: 1000.0 * g.prismatic_residual,
                     identity_residual_mm: 1000.0 * g.identity_residual,
                     observable: g.observable,
                     points: g.points,
                 }),
+                ambiguity: j.ambiguity,
                 flag: j.flag.clone(),
                 end_transform: [row(0), row(1), row(2), [0.0, 0.0, 0.0, 1.0]],
             }

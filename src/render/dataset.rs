@@ -16,6 +16,7 @@
 use glam::{Affine3A, Vec3};
 
 use super::{GtRenderer, PartMesh, RenderedView, posed_part_meshes, sample_state, sample_views};
+use crate::data::sensor::{self, SensorModel};
 use crate::data::{
     Camera, DataError, DatasetWriter, FileSet, Frame, GtJoint, GtMeshes, JointKind as GtKind,
     Split, State, TriMesh, WriteOptions,
@@ -51,8 +52,10 @@ pub struct RenderSpec {
     pub end_range: (f32, f32),
     /// Cameras on the upper hemisphere (above the object's centre) instead of the whole sphere.
     pub upper_hemisphere: bool,
-    /// Seed of the state draw and the camera positions.
+    /// Seed of the state draw and the camera positions (and of the sensor's degradation).
     pub seed: u64,
+    /// Which camera the written frames look as if they came from (default: exact renders).
+    pub sensor: SensorModel,
 }
 
 impl Default for RenderSpec {
@@ -68,6 +71,7 @@ impl Default for RenderSpec {
             end_range: (0.2, 0.4),
             upper_hemisphere: true,
             seed: 0,
+            sensor: SensorModel::Ideal,
         }
     }
 }
@@ -401,7 +405,9 @@ pub async fn render_dataset(
                 let view = renderer
                     .render_view(ctx, &posed[state.index()], &camera)
                     .await?;
-                let frame = frame_of(view, format!("{i:04}"), camera, state.default_time());
+                let mut frame = frame_of(view, format!("{i:04}"), camera, state.default_time());
+                let seed = sensor::frame_seed(spec.seed, state, split, i);
+                spec.sensor.degrade(&mut frame, seed);
                 sink(writer.add_frame(state, split, &frame)?)?;
                 done += 1;
                 progress(RenderProgress { done, total });

@@ -8,14 +8,16 @@ use js_sys::{Array, Function, Object, Reflect, Uint8Array, Uint8ClampedArray};
 use wasm_bindgen::prelude::*;
 
 use super::{budget, context, js_error};
-use crate::data::{FileSet, JointKind, Split, State, read_zip, rebase_on_dataset_root};
+use crate::data::{
+    FileSet, JointKind, SensorModel, Split, State, read_zip, rebase_on_dataset_root,
+};
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
 use crate::fit::observer::{BakeOffView, Command, Marks, Observer, Preview, Progress};
 use crate::gpu::now_seconds;
 use crate::pipeline::preview::PREVIEW_FILE;
 use crate::pipeline::{self, FitInput, PipelineError};
-use crate::render::RenderProgress;
+use crate::render::{RenderProgress, RenderSpec};
 use crate::synth::Category;
 
 /// Seconds between two previews the page is sent.
@@ -117,6 +119,20 @@ pub fn catalogue() -> String {
     .to_string()
 }
 
+/// How the page captures a generated or dropped object for `config`: as `artmesh demo` does
+/// ([`FitConfig::full_demo_capture`]), through the sensor model named `sensor` (absent: ideal).
+pub(super) fn page_capture(
+    config: &FitConfig,
+    seed: u64,
+    sensor: Option<&str>,
+) -> Result<RenderSpec, JsError> {
+    let mut spec = config.full_demo_capture(seed);
+    if let Some(name) = sensor {
+        spec.sensor = name.parse::<SensorModel>().map_err(js_error)?;
+    }
+    Ok(spec)
+}
+
 /// A capture's progress for `on_progress`: `{done, total}` views.
 pub(super) fn view_progress(on_progress: &Function) -> impl FnMut(RenderProgress) + '_ {
     move |p| {
@@ -159,9 +175,11 @@ impl WebDataset {
     }
 
     /// Generates the procedural `category` object with `parts` movable parts from `seed` and
-    /// captures both states as the `preset`'s demo does (`artmesh demo`), at the working size
-    /// and views per state of `budget` (the preset's budget overrides as JSON, optional: see
-    /// `fit`); `on_progress` hears `{done, total}` views.
+    /// captures both states as `artmesh demo` does for the `preset`: four times the working size
+    /// of `budget` (the preset's budget overrides as JSON, optional: see `fit`, at most 512 px),
+    /// its views per state and 4 test views, through the sensor model `sensor` (`"ideal"`,
+    /// `"consumer"`, `"consumer-tracked"`; absent: ideal); `on_progress` hears `{done, total}`
+    /// views.
     pub async fn demo(
         category: String,
         parts: u32,
@@ -169,13 +187,14 @@ impl WebDataset {
         seed: u32,
         on_progress: Function,
         budget: Option<String>,
+        sensor: Option<String>,
     ) -> Result<WebDataset, JsError> {
         let category = Category::parse(&category).map_err(js_error)?;
         let config = budget::fit_config(&preset, budget.as_deref()).map_err(js_error)?;
         let object =
             pipeline::demo::demo_object(category, parts as usize, seed.into()).map_err(js_error)?;
+        let spec = page_capture(&config, seed.into(), sensor.as_deref())?;
         let ctx = context().await?;
-        let spec = config.demo_capture(seed.into());
         let mut on_view = view_progress(&on_progress);
         let input = pipeline::demo::capture_demo(&ctx, &object, category, &spec, &mut on_view)
             .await

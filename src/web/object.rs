@@ -8,7 +8,7 @@ use std::rc::Rc;
 use js_sys::Function;
 use wasm_bindgen::prelude::*;
 
-use super::app::{WebDataset, view_progress};
+use super::app::{WebDataset, page_capture, view_progress};
 use super::{budget, context, js_error};
 use crate::data::{FileLimits, zip_holds_object};
 use crate::pipeline::object::{capture_zipped, object_from_zip};
@@ -24,7 +24,8 @@ impl WebDataset {
 
     /// The object in the `.zip` `bytes` (named `file_name`): its URDF and meshes imported, then
     /// both states captured as the `preset`'s demo does ([`WebDataset::demo`]; `budget` as
-    /// there), the end state from the joints' limits. `on_progress` hears `{done, total}` views.
+    /// there, `sensor` the sensor model), the end state from the joints' limits. `on_progress`
+    /// hears `{done, total}` views.
     /// Throws naming the archive, the URDF and what is wrong: a missing mesh, XML that is not
     /// well-formed, no movable joint, an archive past the page's budgets.
     pub async fn from_object_zip(
@@ -34,8 +35,10 @@ impl WebDataset {
         seed: u32,
         on_progress: Function,
         budget: Option<String>,
+        sensor: Option<String>,
     ) -> Result<WebDataset, JsError> {
         let config = budget::fit_config(&preset, budget.as_deref()).map_err(js_error)?;
+        let spec = page_capture(&config, seed.into(), sensor.as_deref())?;
         // The archive's bytes are dropped once its files are out: only the object stays.
         let zipped = object_from_zip(&file_name, &bytes.to_vec(), &FileLimits::default())
             .map_err(js_error)?;
@@ -43,7 +46,6 @@ impl WebDataset {
             web_sys::console::warn_1(&format!("{file_name}: {w}").into());
         }
         let ctx = context().await?;
-        let spec = config.demo_capture(seed.into());
         let mut on_view = view_progress(&on_progress);
         let input = capture_zipped(&ctx, &zipped, &spec, &mut on_view)
             .await

@@ -225,9 +225,9 @@ fn measured_capture(spec: &mut artmesh::render::RenderSpec) {
 }
 
 /// Noisy depth (σ = 4 mm on every pixel, about a pixel's width at 200²) and depth missing in
-/// every other view still give every joint of the cabinet its type, the axes within 15° (clean:
-/// under 2°; the photometric fit alone at 32²: 38° with one type wrong); the missing views are
-/// named in a warning.
+/// every other view still give every joint of the cabinet its type and its axis within 3°
+/// (issue 46's requirement; the photometric fit alone at 32²: 38° with one type wrong); the
+/// missing views are named in a warning.
 #[test]
 fn measured_joints_survive_noisy_and_missing_depth() {
     let ctx = common::context();
@@ -267,7 +267,7 @@ fn measured_joints_survive_noisy_and_missing_depth() {
     println!("warnings: {:?}", fit.articulation.warnings);
     assert_eq!(metrics.type_accuracy, Some(1.0), "{metrics:?}");
     for pair in &metrics.joints {
-        assert!(pair.axis_ang < 15.0, "{pair:?}");
+        assert!(pair.axis_ang <= 3.0, "{pair:?}");
     }
     assert!(
         fit.articulation
@@ -279,10 +279,9 @@ fn measured_joints_survive_noisy_and_missing_depth() {
     );
 }
 
-/// A movable part that no view's part map shows is an error naming it; a dataset without test
-/// views is fitted, with a warning that the training points judge the refinement.
+/// A movable part that no view's part map shows is an error naming it.
 #[test]
-fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
+fn a_part_in_no_view_is_an_error() {
     let ctx = common::context();
     let err = pollster::block_on(tiny_fit(
         &ctx,
@@ -310,26 +309,66 @@ fn a_part_in_no_view_is_an_error_and_no_test_views_a_warning() {
         err.contains("part(s) 2 appear in no training view"),
         "{err}"
     );
+}
 
-    let (_, fit) = pollster::block_on(tiny_fit(
-        &ctx,
-        Category::Laptop,
-        1,
-        1005,
-        &|spec| {
-            measured_capture(spec);
-            spec.test_views = 0;
-        },
-        &no_edit,
-        &tiny(),
-    ))
-    .unwrap();
-    assert!(
-        fit.articulation
-            .warnings
-            .iter()
-            .any(|w| w.contains("no test views")),
-        "{:?}",
-        fit.articulation.warnings
-    );
+/// The test split is for scoring only: the same capture fitted with its test views' colour,
+/// depth and part maps replaced by garbage gives the same joints. A fit that read them to select
+/// a model or settle a joint would change with them.
+#[test]
+fn the_fit_never_reads_the_test_split() {
+    let ctx = common::context();
+    let fit = |edit: &dyn Fn(&mut artmesh::data::Dataset)| {
+        pollster::block_on(tiny_fit(
+            &ctx,
+            Category::StorageFurniture,
+            2,
+            4,
+            &measured_capture,
+            edit,
+            &tiny(),
+        ))
+        .unwrap()
+        .1
+    };
+    let garbage = |d: &mut artmesh::data::Dataset| {
+        for v in d.views.iter_mut().filter(|v| v.split == Split::Test) {
+            for f in &mut v.frames {
+                for (i, c) in f.rgba.pixels.iter_mut().enumerate() {
+                    *c = (i * 37 % 251) as u8;
+                }
+                if let Some(depth) = f.depth.as_mut() {
+                    for (i, mm) in depth.millimetres.iter_mut().enumerate() {
+                        *mm = 300 + (i * 7919 % 4000) as u16;
+                    }
+                }
+                if let Some(parts) = f.parts.as_mut() {
+                    for (i, id) in parts.ids.iter_mut().enumerate() {
+                        *id = (i % 3) as i16;
+                    }
+                }
+            }
+        }
+    };
+    let (clean, spoiled) = (fit(&no_edit), fit(&garbage));
+    for (a, b) in clean
+        .articulation
+        .joints
+        .iter()
+        .zip(&spoiled.articulation.joints)
+    {
+        println!("part {}: {:?} / {:?}", a.part, a.joint, b.joint);
+        assert_eq!(a.kind, b.kind, "part {}", a.part);
+        assert_eq!(a.decided_by, b.decided_by, "part {}", a.part);
+        // Where each motion takes the corners of a metre cube: bit-identical inputs give
+        // identical fits; the bound only allows for the order of a parallel GPU sum.
+        for corner in 0..8 {
+            let p = glam::DVec3::new(
+                f64::from(corner & 1),
+                f64::from((corner >> 1) & 1),
+                f64::from((corner >> 2) & 1),
+            );
+            let (x, y) = (a.motion.forward(p), b.motion.forward(p));
+            assert!(x.distance(y) < 1e-5, "part {}: {x} / {y}", a.part);
+        }
+    }
 }

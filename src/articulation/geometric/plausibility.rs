@@ -1,9 +1,11 @@
 //! Choosing among revolute fits that explain the clouds equally well: the hinge that meets the
 //! rest of the object ([`Anchor`]), then the one whose colours agree, then the smallest turn.
+//! The hinges the shape allows ([`hinged`]) are also the hypotheses a joint must rule out.
 
 use glam::Vec3;
 
-use super::registration::CloudPair;
+use super::registration::{CloudPair, PointFit};
+use super::{DECISIVE, color_evidence, evidence};
 use crate::articulation::motion::{PartMotion, rotation_axis_angle};
 use crate::articulation::observed::PartCloud;
 use crate::mesh::spatial::KdTree;
@@ -56,42 +58,52 @@ fn axis_gap(m: &PartMotion, part: &PartCloud, anchor: &KdTree) -> f64 {
         .sqrt()
 }
 
-/// Residuals within this factor of the best (plus a tenth of a millimetre) fit as well: a plain
-/// door slab fits turned about its hinge and, flipped, about a line in front of it.
-const SAME_FIT: f64 = 1.5;
+/// Axis gaps within this (m) of the nearest count as meeting the rest of the object, plus twice
+/// the points' noise (`noise`): the gap is measured between noisy points. Geometry: a door's
+/// clearance to its frame is a few millimetres.
+const SAME_GAP: f64 = 0.005;
 
-/// Colour residuals this close (0–1 scale) count as equal.
-const SAME_COLOR: f64 = 0.005;
-
-/// Of fitted motions and their residuals, among those fitting as well as the best
-/// ([`SAME_FIT`]): those whose axis passes closest to the rest of the object ([`axis_gap`],
-/// within 5 mm), then those whose colours agree best ([`CloudPair::color_residual`]), then the
-/// smallest turn (joints rarely turn further).
-pub(super) fn most_plausible(
+/// Of fitted motions and their residuals, those the best does not fit decisively better
+/// ([`evidence`] under [`DECISIVE`]) whose axis passes as close to the rest of the object as the
+/// closest ([`axis_gap`], within [`SAME_GAP`]): the hinges the shape alone allows, each with its
+/// point-by-point fit.
+pub(super) fn hinged(
     fits: &[(f64, PartMotion)],
     pair: &CloudPair,
     anchor: Option<&Anchor>,
-) -> Option<PartMotion> {
-    let best = fits.iter().map(|t| t.0).fold(f64::INFINITY, f64::min);
-    let good: Vec<(f64, PartMotion)> = fits
+    noise: f64,
+) -> Vec<(PartMotion, PointFit)> {
+    let Some(best) = fits.iter().min_by(|a, b| a.0.total_cmp(&b.0)) else {
+        return Vec::new();
+    };
+    let best = pair.point_fit(&best.1);
+    let good: Vec<(f64, PartMotion, PointFit)> = fits
         .iter()
-        .filter(|t| t.0 <= SAME_FIT * best + 1e-4)
-        .map(|t| (anchor.map_or(0.0, |a| a.gap(&t.1, pair)), t.1))
+        .map(|t| (t.1, pair.point_fit(&t.1)))
+        .filter(|(_, f)| evidence(&best, f) < DECISIVE)
+        .map(|(m, f)| (anchor.map_or(0.0, |a| a.gap(&m, pair)), m, f))
         .collect();
     let nearest = good.iter().map(|g| g.0).fold(f64::INFINITY, f64::min);
-    let hinged: Vec<(f64, PartMotion)> = good
+    good.into_iter()
+        .filter(|g| g.0 <= nearest + SAME_GAP + 2.0 * noise)
+        .map(|g| (g.1, g.2))
+        .collect()
+}
+
+/// Of [`hinged`] motions, those whose colours agree as well as the best's (not decisively worse,
+/// [`color_evidence`]), then the smallest turn (joints rarely turn further).
+pub(super) fn most_plausible(hinged: &[(PartMotion, PointFit)]) -> Option<PartMotion> {
+    let mean = |f: &PointFit| f.colors.iter().sum::<f64>() / f.colors.len().max(1) as f64;
+    let truest = hinged
         .iter()
-        .filter(|g| g.0 <= nearest + 0.005)
-        .map(|g| (pair.color_residual(&g.1), g.1))
-        .collect();
-    let truest = hinged.iter().map(|g| g.0).fold(f64::INFINITY, f64::min);
+        .min_by(|a, b| mean(&a.1).total_cmp(&mean(&b.1)))?;
     hinged
         .iter()
-        .filter(|g| g.0 <= truest + SAME_COLOR)
+        .filter(|h| color_evidence(&truest.1, &h.1) < DECISIVE)
         .min_by(|x, y| {
-            rotation_axis_angle(x.1.rotation)
+            rotation_axis_angle(x.0.rotation)
                 .1
-                .total_cmp(&rotation_axis_angle(y.1.rotation).1)
+                .total_cmp(&rotation_axis_angle(y.0.rotation).1)
         })
-        .map(|g| g.1)
+        .map(|h| h.0)
 }

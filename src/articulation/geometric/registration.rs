@@ -3,6 +3,7 @@
 //! kept, and Levenberg–Marquardt steps in the model's own parameters.
 
 use glam::{DQuat, DVec3};
+use serde::Serialize;
 
 use crate::articulation::motion::{PartMotion, rotation_axis_angle};
 use crate::articulation::observed::PartCloud;
@@ -89,17 +90,16 @@ impl<'a> CloudPair<'a> {
         }
     }
 
-    /// The kept (closest [`KEEP`]) matches of `m`, per direction.
-    fn matches(&self, m: &PartMotion) -> Vec<Match> {
-        let mut all = Vec::new();
-        for forward in [true, false] {
+    /// Every point's match under `m` with its squared distance, per direction (start points
+    /// moved by g⁺ first), each cloud in its own order.
+    fn all_matches(&self, m: &PartMotion) -> [Vec<(f64, Match)>; 2] {
+        [true, false].map(|forward| {
             let (from, to, tree) = if forward {
                 (self.start, self.end, &self.end_tree)
             } else {
                 (self.end, self.start, &self.start_tree)
             };
-            let mut side: Vec<(f64, Match)> = from
-                .points
+            from.points
                 .iter()
                 .enumerate()
                 .filter_map(|(k, p)| {
@@ -122,7 +122,14 @@ impl<'a> CloudPair<'a> {
                         },
                     ))
                 })
-                .collect();
+                .collect()
+        })
+    }
+
+    /// The kept (closest [`KEEP`]) matches of `m`, per direction.
+    fn matches(&self, m: &PartMotion) -> Vec<Match> {
+        let mut all = Vec::new();
+        for mut side in self.all_matches(m) {
             side.sort_by(|a, b| a.0.total_cmp(&b.0));
             side.truncate((side.len() as f64 * KEEP).ceil() as usize);
             all.extend(side.into_iter().map(|(_, m)| m));
@@ -130,17 +137,81 @@ impl<'a> CloudPair<'a> {
         all
     }
 
-    /// Mean colour difference (0–1 per channel, mean over RGB) between each point moved by `m`
-    /// and its match in the other state, over the kept matches of both directions: what tells
-    /// apart motions the shape alone cannot (a knob's pointer mark, a door's two faces).
-    pub(crate) fn color_residual(&self, m: &PartMotion) -> f64 {
-        let matches = self.matches(m);
-        matches.iter().map(|c| c.color).sum::<f64>() / matches.len().max(1) as f64
-    }
-
     /// Trimmed RMS point-to-plane residual (m) of `m`, both directions.
     pub(crate) fn residual(&self, m: &PartMotion) -> f64 {
-        rms(&self.matches(m), m)
+        self.fit(m).residual
+    }
+
+    /// How `m` fits: its trimmed RMS residual and the matches kept.
+    pub(crate) fn fit(&self, m: &PartMotion) -> Fit {
+        let matches = self.matches(m);
+        Fit {
+            residual: rms(&matches, m),
+            matches: matches.len(),
+        }
+    }
+
+    /// How `m` fits, point by point: every point's squared point-to-plane residual against its
+    /// nearest neighbour in the other state, untrimmed, in a fixed order (start points, then
+    /// end points), so two motions' fits of the same pair pair up point for point.
+    pub fn point_fit(&self, m: &PartMotion) -> PointFit {
+        let all = self.all_matches(m);
+        let squared: Vec<f64> = all
+            .iter()
+            .flatten()
+            .map(|(_, c)| c.residual(m).powi(2))
+            .collect();
+        let mut sorted = squared.clone();
+        sorted.sort_by(f64::total_cmp);
+        let median = sorted.get(sorted.len() / 2).map_or(0.0, |v| v.sqrt());
+        PointFit {
+            dims: free_parameters(m),
+            median,
+            // Three standard deviations of the residuals, from their median (0.6745 σ for a
+            // normal): the usual bound past which a point is an outlier.
+            cap: (3.0 * median / 0.674_489_750_196_081_7).powi(2),
+            squared,
+            colors: all.iter().flatten().map(|(_, c)| c.color).collect(),
+        }
+    }
+}
+
+/// A motion's residual at every point of a [`CloudPair`] ([`CloudPair::point_fit`]).
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointFit {
+    /// The free parameters of the motion's model ([`free_parameters`]).
+    pub(super) dims: usize,
+    /// The median point's residual (m): robust to the surface seen in one state only, as long
+    /// as both states see most of it.
+    pub median: f64,
+    /// Squared point-to-plane residuals (m²), start points then end points.
+    pub(super) squared: Vec<f64>,
+    /// Past this squared residual (three robust standard deviations) a point counts as not
+    /// explained by the motion: a surface seen in one state only, a mislabelled pixel.
+    pub(super) cap: f64,
+    /// Each point's mean absolute colour difference (0–1, over RGB) from its match: what tells
+    /// apart motions the shape alone cannot (a knob's pointer mark, a door's two faces).
+    pub(super) colors: Vec<f64>,
+}
+
+/// How a motion fits a part's two clouds.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Fit {
+    /// Trimmed RMS point-to-plane residual (m), both directions.
+    pub residual: f64,
+    /// Matches kept, both directions.
+    pub matches: usize,
+}
+
+/// The free parameters of the model `m` belongs to: a slide's 3, a hinge's 5 (angle, axis
+/// direction, the axis line's place), none for not moving.
+fn free_parameters(m: &PartMotion) -> usize {
+    if m.translation != glam::DVec3::ZERO {
+        Model::Prismatic.dims()
+    } else if m.rotation != glam::DQuat::IDENTITY {
+        Model::Revolute.dims()
+    } else {
+        0
     }
 }
 

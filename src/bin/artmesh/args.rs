@@ -1,6 +1,7 @@
 //! What several commands share: capture options, the suite objects a benchmark fits, the
 //! preset budgets, and the GPU context and JSON output every command uses.
 
+use artmesh::data::SensorModel;
 use artmesh::fit::object::FitConfig;
 use artmesh::fit::preset::{BudgetOverrides, Preset};
 use artmesh::fit::reconstruct::{ReconstructionConfig, RemeshMode, SurfaceSource};
@@ -52,6 +53,11 @@ pub struct CaptureArgs {
     /// Cameras on the whole sphere instead of the upper hemisphere.
     #[arg(long)]
     sphere: bool,
+    /// Sensor model of the written frames: ideal (exact renders), consumer (an RGB-D camera's
+    /// depth noise, edge errors and dropouts, a segmenter's ragged part maps) or
+    /// consumer-tracked (consumer, with SLAM-sized camera-pose error).
+    #[arg(long, default_value = "ideal")]
+    sensor: SensorModel,
 }
 
 /// Parses `LOW,HIGH` (two numbers, comma-separated); whether it lies in [0, 1] is the capture's check.
@@ -79,6 +85,7 @@ impl CaptureArgs {
             end_range: self.end_range,
             upper_hemisphere: !self.sphere,
             seed,
+            sensor: self.sensor,
         }
     }
 }

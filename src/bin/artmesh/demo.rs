@@ -3,6 +3,7 @@
 use std::path::PathBuf;
 use std::process::ExitCode;
 
+use artmesh::data::SensorModel;
 use artmesh::pipeline::{self, demo};
 use artmesh::synth::Category;
 
@@ -28,6 +29,9 @@ pub struct DemoArgs {
     /// Seed of the object, its states and cameras.
     #[arg(long, default_value_t = 4)]
     seed: u64,
+    /// Sensor model of the capture (see `render`): ideal, consumer or consumer-tracked.
+    #[arg(long, default_value = "ideal")]
+    sensor: SensorModel,
     #[command(flatten)]
     budget: BudgetArgs,
 }
@@ -52,13 +56,16 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
     let object =
         demo::demo_object(category, usize::from(parts), seed).map_err(|e| e.to_string())?;
     let config = args.budget.fit_config(&args.preset)?;
-    let spec = config.full_demo_capture(seed);
+    let mut spec = config.full_demo_capture(seed);
+    spec.sensor = args.sensor;
     let (size, views) = (spec.width, spec.train_views);
     let folder = NewFolder::create(&out)?;
     let ctx = context()?;
     eprintln!(
-        "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state",
-        object.name, parts
+        "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state, {} sensor",
+        object.name,
+        parts,
+        spec.sensor.label()
     );
     let input = pollster::block_on(demo::capture_demo(
         &ctx,

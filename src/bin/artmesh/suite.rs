@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use artmesh::data::{self, FileSet, PngPixels, encode_png};
+use artmesh::data::{self, FileSet, PngPixels, SensorModel, encode_png};
 use artmesh::gpu::GpuContext;
 use artmesh::render::{SheetEntry, contact_sheet};
 use artmesh::synth::{SuiteEntry, SuiteKind, generate};
@@ -66,6 +66,7 @@ struct CaptureJson {
     start_range: (f32, f32),
     end_range: (f32, f32),
     upper_hemisphere: bool,
+    sensor: SensorModel,
 }
 
 #[derive(Serialize)]
@@ -123,6 +124,7 @@ fn suite(
             start_range: spec0.start_range,
             end_range: spec0.end_range,
             upper_hemisphere: spec0.upper_hemisphere,
+            sensor: spec0.sensor,
         },
         objects: manifest,
     };
@@ -160,6 +162,8 @@ fn suite(
 pub struct CaptureSettings {
     pub size: u32,
     pub train_views: usize,
+    /// The sensor model the frames were degraded with (suites written before it: ideal).
+    pub sensor: SensorModel,
 }
 
 /// What a suite folder's `suite.json` (written by `artmesh suite`) lists: each object's id (its
@@ -180,6 +184,8 @@ pub fn read_suite_listing(dir: &Path) -> Result<SuiteListing, String> {
     struct Capture {
         width: u32,
         train_views: usize,
+        #[serde(default)]
+        sensor: SensorModel,
     }
     #[derive(serde::Deserialize)]
     struct Entry {
@@ -218,6 +224,7 @@ pub fn read_suite_listing(dir: &Path) -> Result<SuiteListing, String> {
         capture: manifest.capture.map(|c| CaptureSettings {
             size: c.width,
             train_views: c.train_views,
+            sensor: c.sensor,
         }),
     })
 }

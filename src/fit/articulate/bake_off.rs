@@ -25,44 +25,34 @@ pub(super) struct Decision {
     pub(super) motions: Vec<PartMotion>,
 }
 
-/// Weight of the bake-off's evidence against the measured one. Its losses (summed over a
-/// part's pixels at the working size) differ by a fraction of a percent where the measured
-/// residuals differ by tens of percent; at this weight a bake-off 5 % apart outvotes a measured
-/// call on the threshold, and a tie leaves the measurements to decide.
-const BAKE_OFF_WEIGHT: f64 = 10.0;
-
 /// A revolute candidate turning further than this (degrees) that the measurements cannot tell
 /// from a slide is a part symmetric under a half turn (a window pane, a flat panel): a half turn
 /// maps it onto itself shifted, so photometry ties too. No joint of either suite turns past 86°.
 const HALF_TURN_DEGREES: f64 = 150.0;
 
-/// The joint type from both models' evidence: ln(prismatic / (slack × revolute)) of the measured
-/// residuals (none when the motion is not observable there) plus [`BAKE_OFF_WEIGHT`] times
-/// ln(prismatic / revolute) of the bake-off's losses; positive (or zero) is revolute, as the
-/// paper breaks ties. A near half turn the measurements cannot tell from a slide is a slide
-/// ([`HALF_TURN_DEGREES`]).
+/// The joint type of a part the measurements saw: theirs where it is decisive (the part went to
+/// the photometric stages for another rival, or a poor fit), else the bake-off's (ties to
+/// revolute, as in the paper); a near half turn the measurements cannot tell from a slide is a
+/// slide ([`HALF_TURN_DEGREES`]).
 fn combined_kind(
     g: &GeometricJoint,
     revolute: &PartMotion,
     revolute_loss: f64,
     prismatic_loss: f64,
 ) -> JointKind {
-    use crate::articulation::geometric::{PRISMATIC_SLACK, SMALL_MARGIN};
+    use crate::articulation::geometric::DECISIVE;
+    if g.observable && g.type_evidence.abs() >= DECISIVE {
+        return g.kind;
+    }
     let (_, angle) = revolute.rotation.to_axis_angle();
     let turn = angle
         .abs()
         .min(std::f64::consts::TAU - angle.abs())
         .to_degrees();
-    if g.margin < SMALL_MARGIN && turn > HALF_TURN_DEGREES {
+    if turn > HALF_TURN_DEGREES {
         return JointKind::Prismatic;
     }
-    let measured = if g.observable {
-        (g.prismatic_residual / (PRISMATIC_SLACK * g.revolute_residual.max(1e-9))).ln()
-    } else {
-        0.0
-    };
-    let photometric = (prismatic_loss.max(1e-12) / revolute_loss.max(1e-12)).ln();
-    if measured + BAKE_OFF_WEIGHT * photometric >= 0.0 {
+    if revolute_loss <= prismatic_loss {
         JointKind::Revolute
     } else {
         JointKind::Prismatic
@@ -215,18 +205,24 @@ pub(super) async fn bake_off(
 mod tests {
     use super::*;
 
-    /// A measured joint whose residuals (mm) barely favour the revolute candidate `revolute`.
+    /// A measured joint whose residuals barely favour the revolute candidate `revolute`: the
+    /// evidence is far from decisive.
     fn tied(revolute: PartMotion) -> GeometricJoint {
         GeometricJoint {
             revolute,
             prismatic: PartMotion::prismatic(DVec3::X * 0.1),
-            revolute_residual: 0.62,
-            prismatic_residual: 0.72,
-            identity_residual: 8.5,
+            revolute_residual: 0.000_62,
+            prismatic_residual: 0.000_621,
+            identity_residual: 0.0085,
             kind: JointKind::Revolute,
-            margin: 0.2,
+            type_evidence: 1.5,
+            margin: 0.3,
+            median_residual: 0.000_4,
+            noise: Some(0.0006),
+            explained: true,
             observable: true,
             points: [5000, 5000],
+            rivals: [None; 3],
         }
     }
 
@@ -250,6 +246,7 @@ mod tests {
             JointKind::Revolute
         );
         let settled = GeometricJoint {
+            type_evidence: 50.0,
             margin: 2.0,
             ..tied(turn(179.0))
         };

@@ -1,35 +1,39 @@
 //! The last stages of the articulation: each refined joint's magnitude registered along its
 //! axis (ours, [`register_along_axis`]; `tiny` and `fast`), then judged against its measured
-//! seed on held-out measurements and replaced by the seed where the seed fits better (never
-//! worse than measured); and what a user should know about the joints.
+//! seed on the training views' measurements: the seed replaces it only where the depth maps
+//! decisively prefer the seed (photometry decides what they cannot, never against them); and
+//! what a user should know about the joints. The test split is for scoring only: nothing here
+//! reads it.
 
 use glam::DVec3;
+
+use crate::articulation::PartMotion;
 
 use super::bake_off::Decision;
 use super::candidates::Candidates;
 use super::config::{ArticulationConfig, GeometryUse};
-use super::measured::{Measured, observe};
-use super::results::FittedJoint;
+use super::measured::Measured;
+use super::results::{Ambiguity, FittedJoint};
 use crate::articulation::axis_registration::register_along_axis;
-use crate::articulation::geometric::{CloudPair, GeometricJoint, SMALL_MARGIN};
+use crate::articulation::geometric::{CloudPair, DECISIVE, EXPLAINED, GeometricJoint, evidence};
 use crate::articulation::init::JointCandidates;
 use crate::articulation::observed::ObservedState;
 use crate::articulation::vertex_motion::StateSurface;
-use crate::data::{Dataset, JointKind, Split};
+use crate::data::JointKind;
 
 /// Rotations and translations below these count as "does not move".
 const STILL_ANGLE_DEG: f64 = 0.5;
 const STILL_DISTANCE_M: f64 = 0.002;
 
-/// The cloud pair judging a refined joint of `part` against its measured seed: the test views'
-/// (`clouds`), or `None` when either state has fewer than 3 points of the part.
+/// The cloud pair judging a refined joint of `part` against its measured seed: the training
+/// views' (`clouds`), or `None` when either state has fewer than 3 points of the part.
 fn judge(clouds: &[ObservedState; 2], part: usize) -> Option<CloudPair<'_>> {
     let [s, e] = clouds;
     let (a, b) = (&s.parts[part], &e.parts[part]);
     (a.points.len() >= 3 && b.points.len() >= 3).then(|| CloudPair::new(a, b))
 }
 
-/// Why a measured (or unmeasured) joint should be checked by hand.
+/// Why a measured (or unmeasured) joint should be checked by hand, apart from an ambiguity.
 fn flag(geometry: Option<&GeometricJoint>, measured: bool) -> Option<String> {
     use crate::articulation::geometric::MIN_POINTS;
     let Some(g) = geometry else {
@@ -47,22 +51,71 @@ fn flag(geometry: Option<&GeometricJoint>, measured: bool) -> Option<String> {
             "its motion is not visible in the depth maps (not moving fits within {:.1} mm of either joint: a part symmetric about its axis?): type and motion come from photometry",
             1000.0 * (g.identity_residual - g.revolute_residual.min(g.prismatic_residual))
         ))
-    } else if g.margin < SMALL_MARGIN {
+    } else if !g.explained {
+        let noise = g.noise.unwrap_or(0.0);
         Some(format!(
-            "joint type decided by a small margin {:.2} (revolute residual {:.2} mm, prismatic {:.2} mm)",
-            g.margin,
-            1000.0 * g.revolute_residual,
-            1000.0 * g.prismatic_residual
+            "no rigid motion explains its depth: the best leaves {:.1} mm at the median point where a correct one leaves about {:.1} mm (over {EXPLAINED}×): is the part rigid, and labelled alike in both states?",
+            1000.0 * g.median_residual,
+            1000.0 * noise
         ))
     } else {
         None
     }
 }
 
+/// What stays ambiguous about the joint of `part` fitted as `motion` (`kind`): the measured
+/// hypotheses the depth maps could not rule out, unless the photometric stages chose among them
+/// (`photometric`), and none of them then beats the fitted joint decisively on the depth maps.
+fn ambiguity(
+    g: &GeometricJoint,
+    kind: JointKind,
+    motion: &PartMotion,
+    photometric: bool,
+    center: DVec3,
+) -> Option<Ambiguity> {
+    let rival = g.open_rivals().next()?;
+    let by = if photometric {
+        "the photometric stages, among the hypotheses the depth maps left open"
+    } else {
+        "the depth maps alone"
+    };
+    // The rival is the fitted joint itself when photometry picked it: the chosen one is its rival.
+    let (alt_kind, alt_motion) = if rival.kind == kind && rival.motion == *motion {
+        (g.kind, g.motion(g.kind))
+    } else {
+        (rival.kind, rival.motion)
+    };
+    Some(Ambiguity {
+        evidence: rival.evidence,
+        margin: rival.evidence / DECISIVE,
+        alternative: alt_motion.joint(alt_kind, center),
+        decided_by: by,
+    })
+}
+
+/// A joint in words: "a hinge along (x, y, z) through (x, y, z) m turning a°" or "a slide
+/// along (x, y, z) by d mm".
+fn describe(j: &crate::data::GtJoint) -> String {
+    let d = j.unit_direction();
+    let (o, m) = (j.origin, j.motion());
+    match j.kind {
+        JointKind::Revolute => format!(
+            "a hinge along ({:.2}, {:.2}, {:.2}) through ({:.3}, {:.3}, {:.3}) m turning {m:.1}°",
+            d.x, d.y, d.z, o.x, o.y, o.z
+        ),
+        JointKind::Prismatic => format!(
+            "a slide along ({:.2}, {:.2}, {:.2}) by {:.0} mm",
+            d.x,
+            d.y,
+            d.z,
+            1000.0 * m
+        ),
+    }
+}
+
 /// The fitted joints of the movable parts: the decided motions, registered along their axes
 /// and judged against their measured seeds.
 pub(super) fn fitted_joints(
-    dataset: &Dataset,
     config: &ArticulationConfig,
     measured: &Measured,
     candidates: &Candidates,
@@ -72,13 +125,6 @@ pub(super) fn fitted_joints(
 ) -> Vec<FittedJoint> {
     let k = decision.kinds.len();
     let trainable = &candidates.trainable;
-    // The clouds that judge refined joints against their measured seeds, observed only when a
-    // measured joint was refined: the test views', else the training views'.
-    let refined_measured = (1..k).any(|p| trainable[p] && measured.joints[p].is_some());
-    let test_clouds = refined_measured
-        .then(|| observe(dataset, config, Split::Test))
-        .flatten();
-    let judging = test_clouds.as_ref().or(measured.train_clouds.as_ref());
     let [surface1, surface2] = surfaces;
 
     (1..k)
@@ -98,19 +144,34 @@ pub(super) fn fitted_joints(
             } else {
                 "none"
             };
-            // Never worse than the measured seed on the held-out measurements.
-            let pair = judging
+            // Photometry decides what the depth maps cannot, never against them: the measured
+            // seed replaces a refined joint it beats decisively on the training views' points.
+            let pair = measured
+                .train_clouds
+                .as_ref()
                 .filter(|_| trainable[part])
                 .and_then(|c| judge(c, part));
             if let (Some(g), Some(pair)) = (geometry, pair) {
                 let seed = g.motion(kind);
-                if pair.residual(&seed) < pair.residual(&motion) {
+                if evidence(&pair.point_fit(&seed), &pair.point_fit(&motion)) >= DECISIVE {
                     motion = seed;
                     axis_registration = None;
                     decided_by = "geometry (kept over the refinement)";
                 }
             }
-            let flag = flag(geometry.as_ref(), config.geometry != GeometryUse::Off);
+            let ambiguity = geometry
+                .as_ref()
+                .and_then(|g| ambiguity(g, kind, &motion, trainable[part], center));
+            let flag = flag(geometry.as_ref(), config.geometry != GeometryUse::Off).or_else(|| {
+                ambiguity.as_ref().map(|a| {
+                    format!(
+                        "ambiguous: the depth maps could not rule out {} (evidence for the fitted joint z = {:.1}, decisive from {DECISIVE:.1}); decided by {}",
+                        describe(&a.alternative),
+                        a.evidence,
+                        a.decided_by
+                    )
+                })
+            });
             FittedJoint {
                 part,
                 kind,
@@ -121,6 +182,7 @@ pub(super) fn fitted_joints(
                 axis_registration,
                 geometry,
                 decided_by,
+                ambiguity,
                 flag,
             }
         })

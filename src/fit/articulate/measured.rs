@@ -4,13 +4,10 @@
 //! skip them.
 
 use super::config::{ArticulationConfig, GeometryUse};
-use crate::articulation::geometric::{Anchor, GeometricJoint, fit_joint};
+use crate::articulation::geometric::{GeometricJoint, measure_joints};
 use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
 use crate::data::{Dataset, Split, State};
 use crate::gpu::{GpuError, GpuResult};
-
-/// Points of the rest of the object a measured joint's axis is checked against.
-const ANCHOR_POINTS: usize = 20_000;
 
 /// What the training views measure.
 pub(super) struct Measured {
@@ -44,25 +41,58 @@ pub(super) fn measure(
     };
     if let Some(clouds) = &train_clouds {
         measurement_warnings(clouds, warnings)?;
-        let has_test_views = [State::Start, State::End]
-            .iter()
-            .all(|&s| dataset.views(s, Split::Test).is_some());
-        if !has_test_views {
-            warnings.push(
-                "the dataset has no test views: refined joints are judged against their measured seeds on the training views' points".into(),
-            );
-        }
     }
-    let joints = measure_joints(k, train_clouds.as_ref());
-    let settled = joints
+    let joints = measure_joints_of(k, train_clouds.as_ref());
+    let settled: Vec<bool> = joints
         .iter()
         .map(|g| config.geometry == GeometryUse::Settle && g.is_some_and(|g| g.settled()))
         .collect();
+    if let Some(clouds) = &train_clouds {
+        unsettled_warning(clouds, &joints, warnings);
+    }
     Ok(Measured {
         train_clouds,
         joints,
         settled,
     })
+}
+
+/// Names the measured parts whose joints the depth and part maps could not settle, with the
+/// noise the depth showed: a capture too noisy to decide gets told so, not a confident guess.
+fn unsettled_warning(
+    clouds: &[ObservedState; 2],
+    joints: &[Option<GeometricJoint>],
+    warnings: &mut Vec<String>,
+) {
+    let measured: Vec<(usize, &GeometricJoint)> = joints
+        .iter()
+        .enumerate()
+        .filter_map(|(p, g)| g.as_ref().map(|g| (p, g)))
+        .collect();
+    let open: Vec<String> = measured
+        .iter()
+        .filter(|(_, g)| !g.settled())
+        .map(|(p, _)| p.to_string())
+        .collect();
+    if open.is_empty() {
+        return;
+    }
+    let noise = clouds[0].noise.map_or(String::new(), |n| {
+        format!(
+            " (depth noise about {:.1} mm at {:.1} m)",
+            1000.0 * n.sigma,
+            n.depth
+        )
+    });
+    let what = if open.len() == measured.len() {
+        "the depth and part maps settle none of the joints".to_string()
+    } else {
+        "the depth and part maps do not settle every joint".to_string()
+    };
+    warnings.push(format!(
+        "{what}{noise}: part(s) {} are decided by the photometric stages among the hypotheses the depth left open; check any flagged below",
+        open.join(", ")
+    ));
 }
 
 /// Both states' clouds of a split, or `None` (no views of it, or the geometry is off).
@@ -78,17 +108,10 @@ pub(super) fn observe(
 
 /// The joints the training views' depth and part maps measure, one per part (`None` for the
 /// base and for a part not measured in both states).
-fn measure_joints(k: usize, train: Option<&[ObservedState; 2]>) -> Vec<Option<GeometricJoint>> {
-    (0..k)
-        .map(|part| {
-            let [s, e] = train.filter(|_| part > 0)?;
-            let anchor = Anchor::new(
-                &s.others(part, ANCHOR_POINTS),
-                &e.others(part, ANCHOR_POINTS),
-            );
-            fit_joint(&s.parts[part], &e.parts[part], Some(&anchor))
-        })
-        .collect()
+fn measure_joints_of(k: usize, train: Option<&[ObservedState; 2]>) -> Vec<Option<GeometricJoint>> {
+    let mut joints = train.map(measure_joints).unwrap_or_default();
+    joints.resize(k, None);
+    joints
 }
 
 /// What a user should know about the measurements: views without depth or part maps. A movable

@@ -45,7 +45,9 @@ mod show;
 mod ssim;
 
 pub use config::{Ablation, ArticulationConfig, GeometryUse, RefineViews, UnknownOption};
-pub use results::{Articulation, ArticulationPoint, ArticulationTimes, BakeOff, FittedJoint};
+pub use results::{
+    Ambiguity, Articulation, ArticulationPoint, ArticulationTimes, BakeOff, FittedJoint,
+};
 
 use glam::DVec3;
 
@@ -145,15 +147,7 @@ pub async fn articulate(
         refine(&mut run, &mut decision, trainable, &surfaces, observer).await?;
     times.refine_s = seconds;
 
-    let joints = fitted_joints(
-        dataset,
-        config,
-        &measured,
-        &candidates,
-        decision,
-        &surfaces,
-        center,
-    );
+    let joints = fitted_joints(config, &measured, &candidates, decision, &surfaces, center);
     joint_warnings(&joints, &mut warnings);
     times.total_s = now_seconds() - t0;
     let refine_steps = run.schedule.refine();

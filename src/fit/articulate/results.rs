@@ -44,9 +44,25 @@ pub struct FittedJoint {
     pub geometry: Option<GeometricJoint>,
     /// What decided the type and the motion: `geometry`, `bake-off`, `geometry+refined`, …
     pub decided_by: &'static str,
+    /// The hypothesis the evidence could not rule out (`None`: every one was ruled out).
+    pub ambiguity: Option<Ambiguity>,
     /// Why this joint should be checked by hand (a close type call, a part too small or
     /// unobservable in the data); `None` when nothing is known to be wrong.
     pub flag: Option<String>,
+}
+
+/// A joint the evidence leaves open: the strongest alternative and how far behind it is.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Ambiguity {
+    /// The evidence (a paired z) of the measured choice over the alternative on the depth maps
+    /// ([`evidence`](crate::articulation::geometric::evidence)).
+    pub evidence: f64,
+    /// `evidence` in units of the decisive level (under 1: not ruled out).
+    pub margin: f64,
+    /// The alternative, in the ground truth's conventions.
+    pub alternative: GtJoint,
+    /// What chose between them.
+    pub decided_by: &'static str,
 }
 
 /// One reported point of the articulation curve.

@@ -272,6 +272,7 @@ mod tests {
             pixels: points.len(),
             labelled: points.len(),
             points,
+            noise: 0.0,
         }
     }
 
@@ -286,6 +287,7 @@ mod tests {
         let normals = vec![Vec3::Z; 6];
         // Measured: part 0 densely at z = 0.5, part 1 with too few points to trust.
         let measured = ObservedState {
+            noise: None,
             parts: vec![square(10, 0.5), square(3, 2.0)],
             views_with_depth: 1,
             views: 1,
@@ -331,6 +333,7 @@ mod tests {
         }
         let field = MeshField::new(vec![Vec3::ZERO; 3], Vec::new(), 1, 0.0);
         let measured = ObservedState {
+            noise: None,
             parts: vec![sheet],
             views_with_depth: 1,
             views: 1,
@@ -365,6 +368,7 @@ mod tests {
     fn with_no_views_to_check_fills_a_loop_stays_open_past_the_unchecked_limit() {
         let field = MeshField::new(vec![Vec3::ZERO; 3], Vec::new(), 1, 0.0);
         let measured = ObservedState {
+            noise: None,
             parts: vec![square(48, 0.0)],
             views_with_depth: 1,
             views: 1,

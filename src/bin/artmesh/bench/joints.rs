@@ -5,9 +5,9 @@ use std::path::PathBuf;
 use std::time::Instant;
 
 use artmesh::articulation::PartMotion;
-use artmesh::articulation::geometric::{Anchor, GeometricJoint, fit_joint};
+use artmesh::articulation::geometric::{GeometricJoint, measure_joints};
 use artmesh::articulation::init::principal_frame;
-use artmesh::articulation::observed::{CloudOptions, observe_dataset};
+use artmesh::articulation::observed::{CloudOptions, DepthNoise, observe_dataset};
 use artmesh::data::{GtJoint, JointKind, Split};
 use artmesh::eval::{BenchmarkTable, EvalOptions, ObjectMetrics, evaluate_object};
 use artmesh::gpu::GpuContext;
@@ -40,15 +40,42 @@ pub fn run(args: &JointsArgs) -> Result<String, String> {
 fn log_object(o: &MeasuredObject) {
     let m = &o.metrics;
     let f = |v: Option<f64>| v.map_or("-".into(), |v| format!("{v:.3}"));
+    // Per joint: axis error, then the measured evidence (type z, margin, residual over the
+    // expected, settled or not).
     let per: Vec<String> = m
         .joints
         .iter()
-        .map(|j| format!("{:.2}", j.axis_ang))
+        .zip(&o.joints)
+        .map(|(j, g)| match g {
+            Some(g) => format!(
+                "{:.2}° ({} z {:.1} m {:.2} r/n {:.2}{})",
+                j.axis_ang,
+                if g.kind == JointKind::Revolute {
+                    "R"
+                } else {
+                    "P"
+                },
+                g.type_evidence,
+                g.margin,
+                g.median_residual / g.noise.unwrap_or(f64::NAN),
+                if g.settled() { " settled" } else { "" }
+            ),
+            None => format!("{:.2}°", j.axis_ang),
+        })
         .collect();
+    let noise = o.noise.map_or("-".into(), |n| {
+        format!(
+            "{:.2} mm at {:.2} m, reach {}",
+            1000.0 * n.sigma,
+            n.depth,
+            n.reach
+        )
+    });
     eprintln!(
-        "bench joints: {} {:.1} s  axis ang {} [{}]  axis pos {}  motion {}  types {}",
+        "bench joints: {} {:.1} s  depth noise {}  axis ang {} [{}]  axis pos {}  motion {}  types {}",
         o.id,
         o.seconds,
+        noise,
         f(m.axis_ang),
         per.join(" "),
         f(m.axis_pos),
@@ -65,6 +92,8 @@ pub struct MeasuredObject {
     pub metrics: ObjectMetrics,
     /// Per movable part, its measured joint (`None`: not in both states' clouds).
     pub joints: Vec<Option<GeometricJoint>>,
+    /// The training views' depth noise, estimated from the start state's maps.
+    pub noise: Option<DepthNoise>,
 }
 
 /// `artmesh bench joints` output.
@@ -97,15 +126,14 @@ pub fn measured_joints(
         }
         let dataset = source.load(ctx, &object)?;
         let start = Instant::now();
-        let [s, e] = observe_dataset(&dataset, Split::Train, clouds)
+        let observed = observe_dataset(&dataset, Split::Train, clouds)
             .ok_or_else(|| format!("{id}: no training views of both states"))?;
-        let joints: Vec<_> = (1..dataset.num_parts)
-            .map(|p| {
-                let anchor = Anchor::new(&s.others(p, 20_000), &e.others(p, 20_000));
-                fit_joint(&s.parts[p], &e.parts[p], Some(&anchor))
-            })
+        let joints: Vec<_> = measure_joints(&observed).into_iter().skip(1).collect();
+        let all: Vec<glam::Vec3> = observed[0]
+            .parts
+            .iter()
+            .flat_map(|c| c.points.clone())
             .collect();
-        let all: Vec<glam::Vec3> = s.parts.iter().flat_map(|c| c.points.clone()).collect();
         let center = principal_frame(&all).map_or(glam::DVec3::ZERO, |f| f.centroid);
         let predicted: Vec<GtJoint> = joints
             .iter()
@@ -133,6 +161,7 @@ pub fn measured_joints(
             seconds,
             metrics,
             joints,
+            noise: observed[0].noise,
         };
         log(&done);
         objects.push(done);

@@ -3,6 +3,7 @@
 
 use std::time::Instant;
 
+use artmesh::data::SensorModel;
 use artmesh::eval::{ChamferOptions, ReconstructionReport, reconstruction_report};
 use artmesh::fit::observer::Unobserved;
 use artmesh::fit::reconstruct::{PhaseTimes, ReconstructionConfig, reconstruct};
@@ -150,6 +151,7 @@ pub fn reconstruct_suite(
         capture: CaptureSettings {
             size,
             train_views: views,
+            sensor: SensorModel::Ideal,
         },
         phases: totals,
         objects,

@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use artmesh::data::{Dataset, read_dataset};
+use artmesh::data::{Dataset, SensorModel, read_dataset};
 use artmesh::gpu::GpuContext;
 use artmesh::render::{RenderSpec, capture_dataset};
 use artmesh::synth::{SuiteEntry, SuiteKind, generate};
@@ -50,6 +50,7 @@ impl SuiteSource {
                 CaptureSettings {
                     size: *size,
                     train_views: *views,
+                    sensor: SensorModel::Ideal,
                 },
             )),
             SuiteSource::Dir(dir) => {
