@@ -166,7 +166,7 @@ impl<'a> CloudPair<'a> {
         let median = sorted.get(sorted.len() / 2).map_or(0.0, |v| v.sqrt());
         PointFit {
             dims: free_parameters(m),
-            median,
+            quartile: sorted.get(sorted.len() / 4).map_or(0.0, |v| v.sqrt()),
             // Three standard deviations of the residuals, from their median (0.6745 σ for a
             // normal): the usual bound past which a point is an outlier.
             cap: (3.0 * median / 0.674_489_750_196_081_7).powi(2),
@@ -181,9 +181,9 @@ impl<'a> CloudPair<'a> {
 pub struct PointFit {
     /// The free parameters of the motion's model ([`free_parameters`]).
     pub(super) dims: usize,
-    /// The median point's residual (m): robust to the surface seen in one state only, as long
-    /// as both states see most of it.
-    pub median: f64,
+    /// The lower quartile of the points' residuals (m): robust to the surface seen in one state
+    /// only (a suitcase's lining, seen open) as long as a quarter is seen in both.
+    pub quartile: f64,
     /// Squared point-to-plane residuals (m²), start points then end points.
     pub(super) squared: Vec<f64>,
     /// Past this squared residual (three robust standard deviations) a point counts as not

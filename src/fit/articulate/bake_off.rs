@@ -217,7 +217,7 @@ mod tests {
             kind: JointKind::Revolute,
             type_evidence: 1.5,
             margin: 0.3,
-            median_residual: 0.000_4,
+            quartile_residual: 0.000_4,
             noise: Some(0.0006),
             explained: true,
             observable: true,

@@ -15,7 +15,7 @@ use super::config::{ArticulationConfig, GeometryUse};
 use super::measured::Measured;
 use super::results::{Ambiguity, FittedJoint};
 use crate::articulation::axis_registration::register_along_axis;
-use crate::articulation::geometric::{CloudPair, DECISIVE, EXPLAINED, GeometricJoint, evidence};
+use crate::articulation::geometric::{CloudPair, DECISIVE, GeometricJoint, evidence};
 use crate::articulation::init::JointCandidates;
 use crate::articulation::observed::ObservedState;
 use crate::articulation::vertex_motion::StateSurface;
@@ -50,13 +50,6 @@ fn flag(geometry: Option<&GeometricJoint>, measured: bool) -> Option<String> {
         Some(format!(
             "its motion is not visible in the depth maps (not moving fits within {:.1} mm of either joint: a part symmetric about its axis?): type and motion come from photometry",
             1000.0 * (g.identity_residual - g.revolute_residual.min(g.prismatic_residual))
-        ))
-    } else if !g.explained {
-        let noise = g.noise.unwrap_or(0.0);
-        Some(format!(
-            "no rigid motion explains its depth: the best leaves {:.1} mm at the median point where a correct one leaves about {:.1} mm (over {EXPLAINED}×): is the part rigid, and labelled alike in both states?",
-            1000.0 * g.median_residual,
-            1000.0 * noise
         ))
     } else {
         None

@@ -57,7 +57,7 @@ fn log_object(o: &MeasuredObject) {
                 },
                 g.type_evidence,
                 g.margin,
-                g.median_residual / g.noise.unwrap_or(f64::NAN),
+                g.quartile_residual / g.noise.unwrap_or(f64::NAN),
                 if g.settled() { " settled" } else { "" }
             ),
             None => format!("{:.2}°", j.axis_ang),
