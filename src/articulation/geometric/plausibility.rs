@@ -4,8 +4,8 @@
 
 use glam::Vec3;
 
+use super::evidence::{DECISIVE, color_evidence, evidence};
 use super::registration::{CloudPair, PointFit};
-use super::{DECISIVE, color_evidence, evidence};
 use crate::articulation::motion::{PartMotion, rotation_axis_angle};
 use crate::articulation::observed::PartCloud;
 use crate::mesh::spatial::KdTree;

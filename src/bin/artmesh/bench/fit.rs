@@ -293,6 +293,13 @@ pub fn fit_suite(
         })
         .collect();
     let (listed, capture) = source.objects()?;
+    eprintln!(
+        "bench fit: {} objects captured at {}², {} views per state, {} sensor",
+        listed.len(),
+        capture.size,
+        capture.train_views,
+        capture.sensor.label()
+    );
     for object in listed {
         if !super::selected(only, &object.id) {
             continue;
