@@ -62,7 +62,7 @@ pub fn run(args: DemoArgs) -> Result<ExitCode, String> {
     let folder = NewFolder::create(&out)?;
     let ctx = context()?;
     eprintln!(
-        "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state, {} sensor",
+        "demo: {} ({} movable parts) captured at {size}x{size}, {views} views per state, sensor: {}",
         object.name,
         parts,
         spec.sensor.label()

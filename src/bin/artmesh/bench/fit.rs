@@ -294,7 +294,7 @@ pub fn fit_suite(
         .collect();
     let (listed, capture) = source.objects()?;
     eprintln!(
-        "bench fit: {} objects captured at {}², {} views per state, {} sensor",
+        "bench fit: {} objects captured at {}², {} views per state, sensor: {}",
         listed.len(),
         capture.size,
         capture.train_views,
