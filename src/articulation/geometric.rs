@@ -89,7 +89,7 @@ pub struct GeometricJoint {
     pub noise: Option<f64>,
     /// Whether `quartile_residual` is within [`EXPLAINED`] times `noise`.
     pub explained: bool,
-    /// Whether moving fits decisively better than not moving.
+    /// Whether moving fits decisively better than not moving, in depth or in colour.
     pub observable: bool,
     /// Points in the start and end clouds.
     pub points: [usize; 2],
@@ -327,7 +327,10 @@ pub fn fit_joint(
     {
         *slot = Some(*h);
     }
-    let still = evidence(best_points, &pair.point_fit(&PartMotion::IDENTITY));
+    // The motion is visible where the depth or the colours (a knob's pointer mark turned about
+    // the knob's own axis) decisively prefer it over not moving.
+    let not_moving = pair.point_fit(&PartMotion::IDENTITY);
+    let still = evidence(best_points, &not_moving).max(color_evidence(best_points, &not_moving));
     Some(GeometricJoint {
         revolute,
         prismatic,
