@@ -30,7 +30,7 @@ use serde::Serialize;
 pub use evidence::{DECISIVE, color_evidence, evidence};
 pub use plausibility::Anchor;
 use plausibility::{hinged, most_plausible};
-pub use registration::{CloudPair, Fit, PointFit};
+pub use registration::{CloudPair, PointFit};
 use registration::{Model, refine};
 
 use super::init::initial_hypotheses;
@@ -189,13 +189,14 @@ fn full_fits(pair: &CloudPair, model: Model, motions: &[PartMotion]) -> Vec<(f64
 /// The best revolute motion and the other hinges that fit about as well: the registrations
 /// (`seeds`) and every turn of [`revolute_starts`] refined briefly on thinned clouds; the best
 /// few distinct ones (within twice the best residual) refined fully; of those the hinges the
-/// shape allows ([`hinged`]), and the [`most_plausible`] of them first.
+/// shape allows ([`hinged`]), and the [`most_plausible`] of them first, each with its
+/// point-by-point fit (the first seed alone when no hinge is left).
 fn best_revolute(
     pair: &CloudPair,
     seeds: &[PartMotion],
     anchor: Option<&Anchor>,
     noise: f64,
-) -> Vec<PartMotion> {
+) -> Vec<(PartMotion, PointFit)> {
     let starts: Vec<PartMotion> = seeds
         .iter()
         .copied()
@@ -214,11 +215,15 @@ fn best_revolute(
     }
     let fits = full_fits(pair, Model::Revolute, &finalists);
     let hinges = hinged(&fits, pair, anchor, noise);
-    let Some(chosen) = most_plausible(&hinges).or(seeds.first().copied()) else {
-        return Vec::new();
+    let Some(chosen) = most_plausible(&hinges) else {
+        return seeds
+            .first()
+            .map(|&m| (m, pair.point_fit(&m)))
+            .into_iter()
+            .collect();
     };
-    let others = hinges.into_iter().map(|h| h.0).filter(|m| *m != chosen);
-    std::iter::once(chosen).chain(others).collect()
+    let (same, others): (Vec<_>, Vec<_>) = hinges.into_iter().partition(|h| h.0 == chosen);
+    same.into_iter().take(1).chain(others).collect()
 }
 
 /// Slides refined fully after the coarse search.
@@ -291,31 +296,36 @@ pub fn fit_joint(
     let pair = CloudPair::new(start, end);
     let revolute_seeds: Vec<PartMotion> = std::iter::once(seeds.revolute).chain(turns).collect();
     let hinges = best_revolute(&pair, &revolute_seeds, anchor, noise.unwrap_or(0.0));
-    let revolute = hinges.first().copied().unwrap_or(seeds.revolute);
-    let slides = best_prismatic(&pair, seeds.prismatic, &revolute);
-    let prismatic = slides.first().copied().unwrap_or(seeds.prismatic);
-    let fit_r = pair.fit(&revolute);
-    let fit_p = pair.fit(&prismatic);
-    let fit_i = pair.fit(&PartMotion::IDENTITY);
-    let (points_r, points_p) = (pair.point_fit(&revolute), pair.point_fit(&prismatic));
-    let type_evidence = evidence(&points_r, &points_p);
+    let (revolute, points_r) = hinges.first()?;
+    let slides: Vec<(PartMotion, PointFit)> = best_prismatic(&pair, seeds.prismatic, revolute)
+        .into_iter()
+        .map(|m| (m, pair.point_fit(&m)))
+        .collect();
+    let (prismatic, points_p) = slides.first()?;
+    let type_evidence = evidence(points_r, points_p);
     // A tie goes to revolute, as the paper's bake-off breaks it; it is no decision either way.
-    let (kind, best_points, others) = if type_evidence >= 0.0 {
-        (JointKind::Revolute, &points_r, &hinges)
+    let (kind, best_points, others, other) = if type_evidence >= 0.0 {
+        (
+            JointKind::Revolute,
+            points_r,
+            &hinges,
+            (JointKind::Prismatic, &slides[0]),
+        )
     } else {
-        (JointKind::Prismatic, &points_p, &slides)
-    };
-    let other = match kind {
-        JointKind::Revolute => (JointKind::Prismatic, prismatic, fit_p),
-        JointKind::Prismatic => (JointKind::Revolute, revolute, fit_r),
+        (
+            JointKind::Prismatic,
+            points_p,
+            &slides,
+            (JointKind::Revolute, &hinges[0]),
+        )
     };
     let mut hypotheses: Vec<Alternative> = std::iter::once(other)
-        .chain(others.iter().skip(1).map(|m| (kind, *m, pair.fit(m))))
-        .map(|(kind, motion, fit)| Alternative {
+        .chain(others.iter().skip(1).map(|h| (kind, h)))
+        .map(|(kind, (motion, fit))| Alternative {
             kind,
-            motion,
+            motion: *motion,
             residual: fit.residual,
-            evidence: evidence(best_points, &pair.point_fit(&motion)),
+            evidence: evidence(best_points, fit),
         })
         .collect();
     hypotheses.sort_by(|a, b| a.evidence.total_cmp(&b.evidence));
@@ -332,11 +342,11 @@ pub fn fit_joint(
     let not_moving = pair.point_fit(&PartMotion::IDENTITY);
     let still = evidence(best_points, &not_moving).max(color_evidence(best_points, &not_moving));
     Some(GeometricJoint {
-        revolute,
-        prismatic,
-        revolute_residual: fit_r.residual,
-        prismatic_residual: fit_p.residual,
-        identity_residual: fit_i.residual,
+        revolute: *revolute,
+        prismatic: *prismatic,
+        revolute_residual: points_r.residual,
+        prismatic_residual: points_p.residual,
+        identity_residual: not_moving.residual,
         kind,
         type_evidence,
         margin: weakest / DECISIVE,

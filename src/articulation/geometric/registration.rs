@@ -3,11 +3,14 @@
 //! kept, and Levenberg–Marquardt steps in the model's own parameters.
 
 use glam::{DQuat, DVec3};
-use serde::Serialize;
 
 use crate::articulation::motion::{PartMotion, rotation_axis_angle};
 use crate::articulation::observed::PartCloud;
 use crate::mesh::spatial::KdTree;
+
+/// The median of |x| for x normal with unit deviation (Φ⁻¹(3/4)): a residual's σ is its
+/// median over this.
+const NORMAL_MEDIAN: f64 = 0.674_489_750_196_081_7;
 
 /// Fraction of matches kept (the rest: surface seen in one state only).
 const KEEP: f64 = 0.85;
@@ -129,26 +132,15 @@ impl<'a> CloudPair<'a> {
     /// The kept (closest [`KEEP`]) matches of `m`, per direction.
     fn matches(&self, m: &PartMotion) -> Vec<Match> {
         let mut all = Vec::new();
-        for mut side in self.all_matches(m) {
-            side.sort_by(|a, b| a.0.total_cmp(&b.0));
-            side.truncate((side.len() as f64 * KEEP).ceil() as usize);
-            all.extend(side.into_iter().map(|(_, m)| m));
+        for side in self.all_matches(m) {
+            all.extend(kept(side).into_iter().map(|(_, m)| m));
         }
         all
     }
 
     /// Trimmed RMS point-to-plane residual (m) of `m`, both directions.
     pub(crate) fn residual(&self, m: &PartMotion) -> f64 {
-        self.fit(m).residual
-    }
-
-    /// How `m` fits: its trimmed RMS residual and the matches kept.
-    pub(crate) fn fit(&self, m: &PartMotion) -> Fit {
-        let matches = self.matches(m);
-        Fit {
-            residual: rms(&matches, m),
-            matches: matches.len(),
-        }
+        rms(&self.matches(m), m)
     }
 
     /// How `m` fits, point by point: every point's squared point-to-plane residual against its
@@ -161,15 +153,30 @@ impl<'a> CloudPair<'a> {
             .flatten()
             .map(|(_, c)| c.residual(m).powi(2))
             .collect();
+        // The trimmed RMS of [`CloudPair::residual`], from the same matches.
+        let (mut sum, mut kept_count, mut offset) = (0.0, 0, 0);
+        for side in &all {
+            let by_distance: Vec<(f64, f64)> = side
+                .iter()
+                .zip(&squared[offset..offset + side.len()])
+                .map(|((d2, _), r2)| (*d2, *r2))
+                .collect();
+            offset += side.len();
+            for (_, r2) in kept(by_distance) {
+                sum += r2;
+                kept_count += 1;
+            }
+        }
         let mut sorted = squared.clone();
         sorted.sort_by(f64::total_cmp);
         let median = sorted.get(sorted.len() / 2).map_or(0.0, |v| v.sqrt());
         PointFit {
+            residual: (sum / kept_count.max(1) as f64).sqrt(),
             dims: free_parameters(m),
             quartile: sorted.get(sorted.len() / 4).map_or(0.0, |v| v.sqrt()),
-            // Three standard deviations of the residuals, from their median (0.6745 σ for a
-            // normal): the usual bound past which a point is an outlier.
-            cap: (3.0 * median / 0.674_489_750_196_081_7).powi(2),
+            // Three standard deviations of the residuals, from their median: the usual bound
+            // past which a point is an outlier.
+            cap: (3.0 * median / NORMAL_MEDIAN).powi(2),
             squared,
             colors: all.iter().flatten().map(|(_, c)| c.color).collect(),
         }
@@ -179,6 +186,8 @@ impl<'a> CloudPair<'a> {
 /// A motion's residual at every point of a [`CloudPair`] ([`CloudPair::point_fit`]).
 #[derive(Debug, Clone, PartialEq)]
 pub struct PointFit {
+    /// The trimmed RMS residual (m), both directions ([`CloudPair::residual`]).
+    pub residual: f64,
     /// The free parameters of the motion's model ([`free_parameters`]).
     pub(super) dims: usize,
     /// The lower quartile of the points' residuals (m): robust to the surface seen in one state
@@ -194,13 +203,11 @@ pub struct PointFit {
     pub(super) colors: Vec<f64>,
 }
 
-/// How a motion fits a part's two clouds.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct Fit {
-    /// Trimmed RMS point-to-plane residual (m), both directions.
-    pub residual: f64,
-    /// Matches kept, both directions.
-    pub matches: usize,
+/// The closest [`KEEP`] of one direction's matches (`(squared distance, match)`), closest first.
+fn kept<T>(mut side: Vec<(f64, T)>) -> Vec<(f64, T)> {
+    side.sort_by(|a, b| a.0.total_cmp(&b.0));
+    side.truncate((side.len() as f64 * KEEP).ceil() as usize);
+    side
 }
 
 /// The free parameters of the model `m` belongs to: a slide's 3, a hinge's 5 (angle, axis

@@ -2,7 +2,7 @@
 //! pixel a point and normal from a plane fitted over a window of its part wide enough that the
 //! noise leaves the normal within [`MAX_NORMAL_ERROR`]; the samples of every view of a state.
 
-use glam::{Vec2, Vec3};
+use glam::{DMat3, DVec3, Vec2, Vec3};
 use serde::Serialize;
 
 use crate::data::Frame;
@@ -349,7 +349,13 @@ impl View<'_> {
         if 4 * n < 3 * (2 * r + 1).pow(2) {
             return None;
         }
-        let [a, b, c] = solve3(m, v)?;
+        // The normal matrix is symmetric, so rows read as columns; (near) singular: the window's
+        // pixels do not spread in both directions.
+        let normal_matrix = DMat3::from_cols_array_2d(&m);
+        if normal_matrix.determinant().abs() < 1e-9 {
+            return None;
+        }
+        let [a, b, c] = (normal_matrix.inverse() * DVec3::from_array(v)).to_array();
         let rss: f64 = window()
             .map(|(dx, dy, d)| (d - a - b * dx - c * dy).powi(2))
             .sum();
@@ -367,26 +373,4 @@ impl View<'_> {
         let variance = (self.sigma_mm / 1000.0).powi(2) / n as f32;
         self.sample(i, part, at(0.0, 0.0), normal, variance)
     }
-}
-
-/// Solves a 3 × 3 system by Cramer's rule; `None` when (near) singular.
-fn solve3(m: [[f64; 3]; 3], v: [f64; 3]) -> Option<[f64; 3]> {
-    let det = |m: &[[f64; 3]; 3]| {
-        m[0][0] * (m[1][1] * m[2][2] - m[1][2] * m[2][1])
-            - m[0][1] * (m[1][0] * m[2][2] - m[1][2] * m[2][0])
-            + m[0][2] * (m[1][0] * m[2][1] - m[1][1] * m[2][0])
-    };
-    let d = det(&m);
-    if d.abs() < 1e-9 {
-        return None;
-    }
-    let mut out = [0.0; 3];
-    for (k, o) in out.iter_mut().enumerate() {
-        let mut mk = m;
-        for row in 0..3 {
-            mk[row][k] = v[row];
-        }
-        *o = det(&mk) / d;
-    }
-    Some(out)
 }

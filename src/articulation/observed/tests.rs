@@ -11,11 +11,7 @@ fn wall(size: u32, metres: f32, sigma_mm: f32, seed: u64) -> Frame {
     let mut rng = Rng::new(seed);
     let n = (size * size) as usize;
     let millimetres = (0..n)
-        .map(|_| {
-            let (u, v) = (rng.uniform(1e-7, 1.0), rng.uniform(0.0, 1.0));
-            let z = (-2.0 * u.ln()).sqrt() * (std::f32::consts::TAU * v).cos();
-            (1000.0 * metres + sigma_mm * z).round() as u16
-        })
+        .map(|_| (1000.0 * metres + sigma_mm * rng.normal()).round() as u16)
         .collect();
     Frame {
         name: "0000".into(),
