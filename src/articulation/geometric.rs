@@ -61,7 +61,9 @@ pub struct Alternative {
     pub evidence: f64,
 }
 
-/// Other optima kept beside the chosen motion, at most.
+/// Open hypotheses kept beside the chosen motion, at most: the other type, the turned-over hinge
+/// and the mirrored slide the search looks for; more would only be further optima of the same
+/// kinds, and [`DECISIVE`] is split over five comparisons on this count.
 pub const MAX_RIVALS: usize = 3;
 
 /// One movable part's geometric fit.
