@@ -20,6 +20,7 @@
 //! hinges in `plausibility` ([`Anchor`]); this file runs the multi-start search per model and
 //! decides the type.
 
+mod alignment;
 mod evidence;
 mod plausibility;
 mod registration;
@@ -27,6 +28,7 @@ mod registration;
 use glam::DVec3;
 use serde::Serialize;
 
+use alignment::{aligned, build_directions};
 pub use evidence::{DECISIVE, color_evidence, evidence};
 pub use plausibility::Anchor;
 use plausibility::{hinged, most_plausible};
@@ -339,13 +341,35 @@ pub fn fit_joint(
     {
         *slot = Some(*h);
     }
+    // The type and the rivals are decided between free axes, each model charged its own
+    // parameters alike; then each model's motion is offered along the directions the object
+    // and the part are built in (`alignment`). A hinge about a fixed direction with its pivot
+    // far off is a slide in any direction across it, so aligned models would not compare fairly
+    // with each other.
+    let frames = [
+        anchor.map(|a| a.directions.clone()).unwrap_or_default(),
+        build_directions(&start.normals),
+    ];
+    let [(revolute, aligned_r), (prismatic, aligned_p)] = parallel::map(
+        &[
+            (Model::Revolute, (*revolute, points_r.clone())),
+            (Model::Prismatic, (*prismatic, points_p.clone())),
+        ],
+        |(model, fit)| aligned(&pair, *model, fit.clone(), &frames),
+    )
+    .try_into()
+    .ok()?;
     // The motion is visible where the depth or the colours (a knob's pointer mark turned about
-    // the knob's own axis) decisively prefer it over not moving.
+    // the knob's own axis) decisively prefer the motion reported over not moving.
+    let chosen = match kind {
+        JointKind::Revolute => &aligned_r,
+        JointKind::Prismatic => &aligned_p,
+    };
     let not_moving = pair.point_fit(&PartMotion::IDENTITY);
-    let still = evidence(best_points, &not_moving).max(color_evidence(best_points, &not_moving));
+    let still = evidence(chosen, &not_moving).max(color_evidence(chosen, &not_moving));
     Some(GeometricJoint {
-        revolute: *revolute,
-        prismatic: *prismatic,
+        revolute,
+        prismatic,
         revolute_residual: points_r.residual,
         prismatic_residual: points_p.residual,
         identity_residual: not_moving.residual,
@@ -408,7 +432,8 @@ pub fn measure_joints(clouds: &[ObservedState; 2]) -> Vec<Option<GeometricJoint>
             let anchor = Anchor::new(
                 &s.others(part, ANCHOR_POINTS),
                 &e.others(part, ANCHOR_POINTS),
-            );
+            )
+            .built_along(&s.parts[0].normals);
             let (a, b) = (&s.parts[part], &e.parts[part]);
             let noise = floor.map(|f| f.hypot(point_noise(a.noise, b.noise)));
             fit_joint(a, b, Some(&anchor), noise)

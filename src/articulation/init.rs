@@ -100,7 +100,7 @@ pub fn principal_frame(points: &[Vec3]) -> Option<PrincipalFrame> {
 }
 
 /// The rotation that best maps centred points `from` onto `to` (Horn's quaternion method).
-fn best_rotation(pairs: &[(DVec3, DVec3)]) -> DQuat {
+pub(crate) fn best_rotation(pairs: &[(DVec3, DVec3)]) -> DQuat {
     let mut s = [[0.0; 3]; 3];
     for (a, b) in pairs {
         for i in 0..3 {

@@ -15,6 +15,7 @@ use serde::Serialize;
 use crate::data::Frame;
 use crate::data::parallel;
 pub use sampling::DepthNoise;
+pub(crate) use sampling::MAX_NORMAL_ERROR;
 use sampling::{Sample, samples};
 
 /// How the clouds are sampled.

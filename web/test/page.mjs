@@ -1,7 +1,8 @@
 // End-to-end test of the page in headless Chromium with WebGPU (SwiftShader where there is no GPU):
 //  1. adapter report and the GPU self-test (button);
 //  2. a dataset written by the native `artmesh demo` fitted in the page, joints compared with the native fit;
-//  3. the page's own demo (default category, 2 parts, tiny), timed against the native demo;
+//  3. the page's own demo (default category, 2 parts, tiny), timed against the native demo; with
+//     ARTMESH_DEMO_PRESET=fast, the preset a hardware adapter starts at, its joints are scored;
 //  4. a joint slider changes the viewer's picture;
 //  5. downloads: the GLB passes the glTF validator, the zip holds <folder>/twin.urdf with joint limits;
 //  6. a malformed dataset, as a folder and as a dropped .zip, is reported by file name;
@@ -26,8 +27,13 @@ import { checkMobileAndTouch } from "./touch.mjs";
 // the browser) asserts the issue's 0.5° / 5 mm (docs/results.md, "Browser vs native").
 const parityPreset = process.env.ARTMESH_PARITY_PRESET ?? "tiny";
 const parityMinutes = parityPreset === "tiny" ? 10 : 50;
-// The whole run's limit, the parity fit's plus the other steps'.
-const TOTAL_MINUTES = parityPreset === "tiny" ? 25 : 60;
+// The page demo's preset: tiny, as a software adapter starts, in CI; ARTMESH_DEMO_PRESET=fast is
+// what a hardware adapter starts at, and there the demo must get both joint types right and every
+// axis within 2° (issue 46). SwiftShader takes tens of minutes over a fast fit, so CI leaves it out.
+const demoPreset = process.env.ARTMESH_DEMO_PRESET ?? "tiny";
+const demoMinutes = demoPreset === "tiny" ? 10 : 50;
+// The whole run's limit, the parity fit's and the demo's plus the other steps'.
+const TOTAL_MINUTES = parityMinutes + demoMinutes + 5;
 let failed = 0, passed = 0;
 const check = (ok, what) => {
   console.log(`${ok ? "ok  " : "FAIL"} ${what}`);
@@ -297,13 +303,13 @@ try {
   await step("browser demo", async () => {
     const def = await page.evaluate(() => window.artmeshCatalogue?.default ?? null);
     const category = def?.category ?? (await page.inputValue("#demo-category"));
-    const nativeS = native(["demo", "--preset", "tiny", "--category", category, "--parts", "2", "--seed", "0",
+    const nativeS = native(["demo", "--preset", demoPreset, "--category", category, "--parts", "2", "--seed", "0",
       "--out", join(work, "native-demo")]);
-    console.log(`native demo (${category}, 2 parts, tiny): ${nativeS.toFixed(1)} s`);
+    console.log(`native demo (${category}, 2 parts, ${demoPreset}): ${nativeS.toFixed(1)} s`);
 
     await page.selectOption("#demo-category", category);
     await page.fill("#demo-parts", "2");
-    await page.selectOption("#demo-preset", "tiny");
+    await page.selectOption("#demo-preset", demoPreset);
     await page.fill("#demo-seed", "0");
     await clearFlags("result", "fit", "preview", "demo", "moved", "bakeOffs");
     const t0 = performance.now();
@@ -312,14 +318,22 @@ try {
     await page.waitForFunction(() => {
       const d = document.body.dataset;
       return d.result === "ready" || d.demo === "error" || ["error", "cancelled"].includes(d.fit) || d.state === "panic";
-    }, null, { timeout: 600_000, polling: 500 });
+    }, null, { timeout: demoMinutes * 60_000, polling: 500 });
     const browserS = (performance.now() - t0) / 1000;
     const state = await body();
     if (!check(state.result === "ready", `browser demo finished (result=${state.result}, fit=${state.fit}, demo=${state.demo}` +
       `${state.fitError ? ", " + state.fitError : ""})`)) return;
-    console.log(`browser demo (tiny): ${browserS.toFixed(1)} s`);
+    console.log(`browser demo (${demoPreset}): ${browserS.toFixed(1)} s`);
     console.log(`demo timing: native ${nativeS.toFixed(1)} s, browser ${browserS.toFixed(1)} s` +
-      ` (${category}, 2 parts, seed 0, tiny; native laptop 1 part: ${nativeLaptopS?.toFixed(1) ?? "—"} s)`);
+      ` (${category}, 2 parts, seed 0, ${demoPreset}; native laptop 1 part: ${nativeLaptopS?.toFixed(1) ?? "—"} s)`);
+    if (demoPreset !== "tiny") {
+      const metrics = parse((await page.evaluate(() => window.artmeshLast ?? null))?.report ?? "{}").metrics;
+      const joints = metrics?.joints ?? [];
+      check(joints.length === 2 && joints.every((j) => j.type_correct),
+        `the ${demoPreset} demo types both joints right (${joints.map((j) => `${j.gt_kind}→${j.pred_kind}`).join(", ")})`);
+      check(joints.length > 0 && joints.every((j) => j.axis_ang <= 2),
+        `the ${demoPreset} demo's axes are within 2° (${joints.map((j) => j.axis_ang.toFixed(2) + "°").join(", ")})`);
+    }
     const visible = await page.locator("#metrics").isVisible();
     const rows = await page.locator("#metrics tbody tr").count();
     check(visible && rows >= 3, `metrics table shown with ${rows} rows`);

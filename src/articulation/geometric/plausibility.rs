@@ -2,7 +2,9 @@
 //! rest of the object ([`Anchor`]), then the one whose colours agree, then the smallest turn.
 //! The hinges the shape allows ([`hinged`]) are also the hypotheses a joint must rule out.
 
-use glam::Vec3;
+use glam::{DVec3, Vec3};
+
+use super::alignment::build_directions;
 
 use super::evidence::{DECISIVE, color_evidence, evidence};
 use super::registration::{CloudPair, PointFit};
@@ -10,10 +12,12 @@ use crate::articulation::motion::{PartMotion, rotation_axis_angle};
 use crate::articulation::observed::PartCloud;
 use crate::mesh::spatial::KdTree;
 
-/// The rest of the object in both states, which a part's hinge joins it to.
+/// The rest of the object in both states, which a part's hinge joins it to, and the directions
+/// it is built along.
 pub struct Anchor {
     start: KdTree,
     end: KdTree,
+    pub(super) directions: Vec<DVec3>,
 }
 
 impl Anchor {
@@ -22,6 +26,16 @@ impl Anchor {
         Self {
             start: KdTree::new(start),
             end: KdTree::new(end),
+            directions: Vec::new(),
+        }
+    }
+
+    /// The anchor built along the principal axes of `normals` (the static base's surface
+    /// normals, [`build_directions`]).
+    pub fn built_along(self, normals: &[Vec3]) -> Self {
+        Self {
+            directions: build_directions(normals),
+            ..self
         }
     }
 

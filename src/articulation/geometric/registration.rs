@@ -20,14 +20,20 @@ const KEEP: f64 = 0.85;
 pub(super) enum Model {
     Revolute,
     Prismatic,
+    /// A hinge about a fixed direction (`alignment`): angle and pivot.
+    Turn(DVec3),
+    /// A slide along a fixed direction (`alignment`): its length.
+    Slide(DVec3),
 }
 
 impl Model {
     /// Number of local parameters.
-    fn dims(self) -> usize {
+    pub(super) fn dims(self) -> usize {
         match self {
             Model::Revolute => 5,
             Model::Prismatic => 3,
+            Model::Turn(_) => 3,
+            Model::Slide(_) => 1,
         }
     }
 
@@ -47,6 +53,17 @@ impl Model {
                     translation: DVec3::ZERO,
                 }
             }
+            Model::Turn(d) => {
+                let (axis, angle) = rotation_axis_angle(m.rotation);
+                let angle = if axis.dot(d) < 0.0 { -angle } else { angle };
+                let (u, v) = d.any_orthonormal_pair();
+                PartMotion {
+                    rotation: DQuat::from_axis_angle(d, angle + delta[0]),
+                    pivot: m.pivot + delta[1] * u + delta[2] * v,
+                    translation: DVec3::ZERO,
+                }
+            }
+            Model::Slide(d) => PartMotion::prismatic(m.translation + delta[0] * d),
         }
     }
 }
@@ -179,6 +196,16 @@ impl<'a> CloudPair<'a> {
             cap: (3.0 * median / NORMAL_MEDIAN).powi(2),
             squared,
             colors: all.iter().flatten().map(|(_, c)| c.color).collect(),
+        }
+    }
+}
+
+impl CloudPair<'_> {
+    /// [`CloudPair::point_fit`] of a motion of `model`, charged that model's parameters.
+    pub(super) fn model_fit(&self, m: &PartMotion, model: Model) -> PointFit {
+        PointFit {
+            dims: model.dims(),
+            ..self.point_fit(m)
         }
     }
 }

@@ -163,7 +163,7 @@ pub(super) fn view_noise(
 /// apart by the normal's dominant axis, which needs well under 45°, and a match one point
 /// spacing ℓ away is then off by about ℓ/10 in its point-to-plane distance, under the spread of
 /// the voxel averaging itself (ℓ/√12).
-pub(super) const MAX_NORMAL_ERROR: f32 = 0.1;
+pub(crate) const MAX_NORMAL_ERROR: f32 = 0.1;
 
 /// The half-width (px) of the window a view's samples are fitted over: the smallest whose
 /// least-squares plane has a normal error σ / (f √S) under [`MAX_NORMAL_ERROR`], with f the

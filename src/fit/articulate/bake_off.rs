@@ -34,6 +34,11 @@ const HALF_TURN_DEGREES: f64 = 150.0;
 /// the photometric stages for another rival, or a poor fit), else the bake-off's (ties to
 /// revolute, as in the paper); a near half turn the measurements cannot tell from a slide is a
 /// slide ([`HALF_TURN_DEGREES`]).
+///
+/// A motion the depth does not show counts too when a hinge fits decisively better than any
+/// slide: a bounded part moved along any line leaves where it was, so a movable part that shows
+/// no motion has turned about an axis it is symmetric about (a knob), and the hinge found is that
+/// axis. Its angle stays photometry's, and the joint is flagged.
 fn combined_kind(
     g: &GeometricJoint,
     revolute: &PartMotion,
@@ -41,7 +46,8 @@ fn combined_kind(
     prismatic_loss: f64,
 ) -> JointKind {
     use crate::articulation::geometric::DECISIVE;
-    if g.observable && g.type_evidence.abs() >= DECISIVE {
+    let symmetric_turn = !g.observable && g.kind == JointKind::Revolute;
+    if (g.observable || symmetric_turn) && g.type_evidence.abs() >= DECISIVE {
         return g.kind;
     }
     let (_, angle) = revolute.rotation.to_axis_angle();
@@ -253,6 +259,33 @@ mod tests {
         assert_eq!(
             combined_kind(&settled, &settled.revolute, rot, trans),
             JointKind::Revolute
+        );
+    }
+
+    #[test]
+    fn a_part_whose_motion_does_not_show_but_fits_a_hinge_decisively_turned() {
+        // A knob turned about its own axis: not moving fits as well as any motion, but a hinge
+        // fits decisively better than any slide. The bake-off, at a few pixels a knob, leans
+        // prismatic; no slide of a bounded part leaves it where it was, so it turned.
+        let turn = PartMotion::revolute(DVec3::Y, DVec3::ZERO, 1.2);
+        let (rot, trans) = (0.547, 0.495);
+        let knob = GeometricJoint {
+            type_evidence: 3.9,
+            observable: false,
+            ..tied(turn)
+        };
+        assert_eq!(
+            combined_kind(&knob, &knob.revolute, rot, trans),
+            JointKind::Revolute
+        );
+        // Without decisive evidence for the hinge, the bake-off decides.
+        let unsure = GeometricJoint {
+            type_evidence: 2.0,
+            ..knob
+        };
+        assert_eq!(
+            combined_kind(&unsure, &unsure.revolute, rot, trans),
+            JointKind::Prismatic
         );
     }
 }

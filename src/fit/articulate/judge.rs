@@ -48,8 +48,13 @@ fn flag(geometry: Option<&GeometricJoint>, measured: bool) -> Option<String> {
         ))
     } else if !g.observable {
         Some(format!(
-            "its motion is not visible in the depth maps (not moving fits within {:.1} mm of either joint: a part symmetric about its axis?): type and motion come from photometry",
-            1000.0 * (g.identity_residual - g.revolute_residual.min(g.prismatic_residual))
+            "its motion is not visible in the depth maps (not moving fits within {:.1} mm of either joint: a part symmetric about its axis?): {}",
+            1000.0 * (g.identity_residual - g.revolute_residual.min(g.prismatic_residual)),
+            if g.kind == JointKind::Revolute && g.type_evidence >= DECISIVE {
+                "a turn about its axis of symmetry, the only motion that does not show (a hinge fits decisively better than any slide); its angle comes from photometry"
+            } else {
+                "type and motion come from photometry"
+            }
         ))
     } else {
         None
