@@ -61,8 +61,12 @@ function native(args) {
   return (performance.now() - t0) / 1000;
 }
 
+// ARTMESH_PAGE_STEPS: only these steps (names, comma-separated), for a long check run on its own,
+// such as the fast demo; the GPU self-test, which opens the page, always runs.
+const onlySteps = process.env.ARTMESH_PAGE_STEPS?.split(",").map((s) => s.trim());
 const timings = [];
 async function step(name, fn) {
+  if (onlySteps && name !== "GPU self-test" && !onlySteps.includes(name)) return;
   console.log(`--- ${name}`);
   const t0 = performance.now();
   try {
