@@ -2,7 +2,8 @@
 // shown: the play button (aria-pressed, keyboard, the picture moves while playing and holds when
 // paused, a slider or a state stops it), the part-colour legend (one entry per part, distinct
 // colours, the wasm palette's, found in the picture), the true parts' overlay (changes the
-// picture, and off restores it) and the opening view's score; no console errors meanwhile.
+// picture, and off restores it) and the opening view's score; no console errors meanwhile. Also the
+// page demo's score against its ground truth, for a demo at a hardware adapter's preset.
 import { writeFile } from "node:fs/promises";
 import { changed, settle, snapshot } from "./canvas.mjs";
 
@@ -144,4 +145,16 @@ export async function checkResultViewer({ page, check, artefacts }) {
     page.off("pageerror", onError);
   }
   check(errors.length === 0, `no console errors in the result viewer checks (${errors.join(" | ") || "none"})`);
+}
+
+/** The page demo's joints against its ground truth (report.json's metrics): both types right and
+ * every axis within 2°, what a demo at a hardware adapter's preset must give (issue 46). */
+export async function checkDemoScore({ page, check, preset }) {
+  const last = await page.evaluate(() => window.artmeshLast ?? null);
+  const report = typeof last?.report === "string" ? JSON.parse(last.report) : last?.report;
+  const joints = report?.metrics?.joints ?? [];
+  check(joints.length === 2 && joints.every((j) => j.type_correct),
+    `the ${preset} demo types both joints right (${joints.map((j) => `${j.gt_kind}→${j.pred_kind}`).join(", ")})`);
+  check(joints.length > 0 && joints.every((j) => j.axis_ang <= 2),
+    `the ${preset} demo's axes are within 2° (${joints.map((j) => j.axis_ang.toFixed(2) + "°").join(", ")})`);
 }
