@@ -21,6 +21,7 @@
 //! decides the type.
 
 mod alignment;
+mod angle_range;
 mod evidence;
 mod plausibility;
 mod registration;
@@ -29,6 +30,7 @@ use glam::DVec3;
 use serde::Serialize;
 
 use alignment::{aligned, build_directions};
+use angle_range::angle_range;
 pub use evidence::{DECISIVE, color_evidence, evidence};
 pub use plausibility::Anchor;
 use plausibility::{hinged, most_plausible};
@@ -97,6 +99,9 @@ pub struct GeometricJoint {
     pub observable: bool,
     /// Points in the start and end clouds.
     pub points: [usize; 2],
+    /// The revolute model's turns (degrees less and more than its angle) nearest to it that the
+    /// depth rules out, at most 180 (`angle_range`): how well the depth knows the angle.
+    pub angle_range: Option<[f64; 2]>,
     /// The hypotheses not ruled out decisively, weakest evidence first.
     pub rivals: [Option<Alternative>; MAX_RIVALS],
 }
@@ -365,6 +370,7 @@ pub fn fit_joint(
         JointKind::Revolute => &aligned_r,
         JointKind::Prismatic => &aligned_p,
     };
+    let angle_range = angle_range(&pair, &(revolute, aligned_r.clone()));
     let not_moving = pair.point_fit(&PartMotion::IDENTITY);
     let still = evidence(chosen, &not_moving).max(color_evidence(chosen, &not_moving));
     Some(GeometricJoint {
@@ -381,6 +387,7 @@ pub fn fit_joint(
         explained: noise.is_none_or(|n| best_points.quartile <= EXPLAINED * n),
         observable: still >= DECISIVE,
         points: [start.points.len(), end.points.len()],
+        angle_range,
         rivals,
     })
 }

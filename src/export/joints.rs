@@ -74,6 +74,10 @@ pub struct GeometryRecord {
     pub observable: bool,
     /// Points of the part in the start and end clouds.
     pub points: [usize; 2],
+    /// The measured hinge's nearest turns (degrees less and more than its angle) the depth
+    /// rules out, at most 180: how well the depth knows the angle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub angle_range_deg: Option<[f64; 2]>,
 }
 
 /// The joints of `fit` for `joints.json`.
@@ -108,6 +112,7 @@ pub fn joint_records(fit: &ObjectFit) -> Vec<JointRecord> {
                     identity_residual_mm: 1000.0 * g.identity_residual,
                     observable: g.observable,
                     points: g.points,
+                    angle_range_deg: g.angle_range,
                 }),
                 ambiguity: j.ambiguity,
                 flag: j.flag.clone(),

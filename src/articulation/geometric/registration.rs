@@ -24,6 +24,8 @@ pub(super) enum Model {
     Turn(DVec3),
     /// A slide along a fixed direction (`alignment`): its length.
     Slide(DVec3),
+    /// A hinge's pivot across its axis, the turn held (`angle_range`).
+    Pivot,
 }
 
 impl Model {
@@ -34,6 +36,7 @@ impl Model {
             Model::Prismatic => 3,
             Model::Turn(_) => 3,
             Model::Slide(_) => 1,
+            Model::Pivot => 2,
         }
     }
 
@@ -64,6 +67,13 @@ impl Model {
                 }
             }
             Model::Slide(d) => PartMotion::prismatic(m.translation + delta[0] * d),
+            Model::Pivot => {
+                let (u, v) = rotation_axis_angle(m.rotation).0.any_orthonormal_pair();
+                PartMotion {
+                    pivot: m.pivot + delta[0] * u + delta[1] * v,
+                    ..*m
+                }
+            }
         }
     }
 }

@@ -238,6 +238,7 @@ mod tests {
             explained: true,
             observable: true,
             points: [5000, 5000],
+            angle_range: Some([1.0, 1.0]),
             rivals: [None; 3],
         }
     }
