@@ -235,6 +235,10 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what) {
     update();
     $("fit-progress").value = 1;
     const seconds = (performance.now() - t0) / 1000;
+    // The last progress event's elapsed time and estimate are stale once the fit returns: the
+    // panel's elapsed time is the one "Done in" gives, and nothing remains.
+    text("fit-elapsed", fmtDuration(seconds));
+    text("fit-eta", "none (done)");
     show($("fit-status"), `Done in ${fmtDuration(seconds)}.`, "ok");
     drawTimeline();
     return result;
@@ -266,6 +270,8 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what) {
 export function markFitDone() {
   setFit("done");
   text("fit-stage", "finished: every stage ran");
-  text("fit-phase", "done");
+  text("fit-phase", "done (both phases finished)");
+  text("fit-state", "both");
+  text("fit-eta", "none (done)");
   drawTimeline();
 }

@@ -1,8 +1,10 @@
 // The Result section: the WebGPU viewer of the twin (orbit, zoom, a slider per joint, a play
 // button animating every joint between its states, the part-colour legend, the true parts laid
-// over the fit), the metrics and joints tables, the report's warnings and the downloads.
+// over the fit), the metrics table (the joints table is joints-table.js), the report's warnings and
+// the downloads.
 // Sets `document.body.dataset.result = "ready"` and `document.body.dataset.jointCount`.
 import { $, errorText, fmtNum, freeQuietly } from "./util.js";
+import { fillJoints } from "./joints-table.js";
 
 let viewer = null;
 let result = null;
@@ -212,8 +214,19 @@ function buildSliders(joints) {
     if (lo === hi) { lo -= j.unit === "m" ? 0.01 : 1; hi += j.unit === "m" ? 0.01 : 1; }
     input.min = String(lo);
     input.max = String(hi);
-    input.step = String((hi - lo) / 500);
+    // Any value (so both states are reachable); the keys step by a unit a reader thinks in: 1° or
+    // 1 mm, ten of them with Page Up/Down.
+    input.step = "any";
     input.value = String(j.start ?? lo);
+    const unitStep = j.unit === "m" ? 0.001 : 1;
+    const keySteps = { ArrowRight: 1, ArrowUp: 1, ArrowLeft: -1, ArrowDown: -1, PageUp: 10, PageDown: -10 };
+    input.addEventListener("keydown", (e) => {
+      const k = keySteps[e.key];
+      if (k == null) return;
+      e.preventDefault();
+      input.value = String(Math.min(hi, Math.max(lo, Number(input.value) + k * unitStep)));
+      input.dispatchEvent(new Event("input", { bubbles: true }));
+    });
     const name = `${j.name ?? `joint ${i}`} (${j.type ?? "?"}, part ${j.part ?? i + 1})`;
     const setLabel = (v) => { label.textContent = `${name}: ${fmtValue(v, j.unit)}`; };
     setLabel(input.value);
@@ -250,8 +263,6 @@ function row(tbody, cells) {
   return tr;
 }
 
-const vec = (v) => (Array.isArray(v) ? `(${v.map((x) => fmtNum(x, 3)).join(", ")})` : "—");
-
 function chamfer(c) {
   if (!c) return "—";
   const mm = c.cd_mm != null ? ` (${fmtNum(c.cd_mm, 1)} mm)` : "";
@@ -281,64 +292,15 @@ function fillMetrics(m) {
   metricRow(tbody, "Axis Pos (mm)", fmtNum(scaled(m.axis_pos, 100), 2),
     "distance between each fitted hinge line and the true one (hinges only), mean");
   metricRow(tbody, "Part Motion, hinges (°)", fmtNum(m.part_motion_revolute, 3),
-    "how far each fitted turn is from the true turn, mean over hinges");
+    "the angle between each fitted and true rotation (so it counts the axis error too), mean over hinges");
   metricRow(tbody, "Part Motion, slides (mm)", fmtNum(scaled(m.part_motion_prismatic, 1000), 2),
-    "how far each fitted slide is from the true slide, mean over slides");
+    "the distance between each fitted and true displacement (so it counts the axis error too), mean over slides");
   metricRow(tbody, "CD-s (mm)", m.cd_s?.cd_mm != null ? fmtNum(m.cd_s.cd_mm, 1) : "—",
     "Chamfer distance between the fitted and the true static part: mean distance from each surface to the other");
   metricRow(tbody, "CD-m (mm)", m.cd_m?.cd_mm != null ? fmtNum(m.cd_m.cd_mm, 1) : "—",
     "the same for the movable parts, mean over parts");
   metricRow(tbody, "Joint types right", types, "hinge or slide, as the truth has it");
   box.hidden = false;
-}
-
-/** The dot product of two 3-vectors (1 when either is missing, so nothing is flipped). */
-const dot3 = (a, b) => (Array.isArray(a) && Array.isArray(b) ? a[0] * b[0] + a[1] * b[1] + a[2] * b[2] : 1);
-
-/** A joint's motion in its unit: degrees for a hinge, centimetres for a slide. */
-const motionText = (j) => (j.type === "prismatic" ? `${fmtNum(j.motion * 100, 1)} cm` : `${fmtNum(j.motion, 1)}°`);
-
-/** An error cell: the text, and the number (in the shown unit) for scripts and tests. */
-function errorCell(tr, value, digits, unit) {
-  const cell = tr.insertCell();
-  cell.textContent = value == null ? "—" : `${fmtNum(value, digits)} ${unit}`;
-  if (value != null) cell.dataset.value = String(value);
-  return cell;
-}
-
-/**
- * The joints table: each fitted joint, and when the truth is known the true joint below it, with
- * the errors report.json's metrics give (axis angle in °, hinge line distance in mm, motion in °
- * for a hinge and mm for a slide).
- */
-function fillJoints(joints, truth, scored) {
-  const table = $("joints-table");
-  const tbody = table.querySelector("tbody");
-  tbody.replaceChildren();
-  const known = Array.isArray(truth) && truth.length > 0;
-  table.classList.toggle("with-truth", known);
-  joints.forEach((j, i) => {
-    const m = Array.isArray(scored) ? scored.find((s) => s.pred === i) : null;
-    const tr = row(tbody, [String(j.part), "fitted", j.type, vec(j.direction),
-      j.type === "prismatic" ? "—" : vec(j.origin), motionText(j)]);
-    tr.dataset.joint = String(i);
-    if (!known) return;
-    errorCell(tr, m?.axis_ang, 2, "°").dataset.metric = "axis_ang";
-    errorCell(tr, scaled(m?.axis_pos, 100), 2, "mm").dataset.metric = "axis_pos";
-    const prismatic = m?.gt_kind === "prismatic";
-    errorCell(tr, m ? (prismatic ? m.part_motion * 1000 : m.part_motion) : null, 2, prismatic ? "mm" : "°")
-      .dataset.metric = "part_motion";
-    let t = m ? truth[m.gt] : null;
-    // An axis and its opposite with the opposite motion are one joint: show the truth the fitted way round.
-    if (t && dot3(t.direction, j.direction) < 0) {
-      t = { ...t, direction: t.direction.map((x) => -x), motion: -t.motion };
-    }
-    if (t) {
-      const tt = row(tbody, ["", "true", t.type, vec(t.direction), t.type === "prismatic" ? "—" : vec(t.origin),
-        motionText(t), "", "", ""]);
-      tt.className = "truth";
-    }
-  });
 }
 
 function fillWarnings(warnings) {

@@ -87,6 +87,8 @@ pub fn object_from_zip(
 
 /// Captures the zipped object in both states as `spec` says (the demo's capture for the fit's
 /// preset, [`crate::fit::object::FitConfig::demo_capture`]); `on_view` hears the views rendered.
+/// The dataset is named after the archive (what the user dropped), not the URDF's robot, which
+/// exporters often call "Scene" or "robot".
 /// Errors (an object the part model cannot describe, a GPU failure) name the archive and URDF.
 pub async fn capture_zipped(
     ctx: &GpuContext,
@@ -94,7 +96,35 @@ pub async fn capture_zipped(
     spec: &RenderSpec,
     on_view: &mut dyn FnMut(RenderProgress),
 ) -> Result<FitInput, PipelineError> {
-    capture_object(ctx, &zipped.object, UNKNOWN_CATEGORY, spec, on_view)
+    let mut input = capture_object(ctx, &zipped.object, UNKNOWN_CATEGORY, spec, on_view)
         .await
-        .map_err(|e| PipelineError::Object(format!("{}: {}: {e}", zipped.archive, zipped.urdf)))
+        .map_err(|e| PipelineError::Object(format!("{}: {}: {e}", zipped.archive, zipped.urdf)))?;
+    input.id = archive_stem(&zipped.archive).to_string();
+    Ok(input)
+}
+
+/// The archive's file name without its folders and its `.zip`: "objects/dishwasher.zip" →
+/// "dishwasher" (the whole name when nothing is left).
+fn archive_stem(archive: &str) -> &str {
+    let name = archive.rsplit(['/', '\\']).next().unwrap_or(archive);
+    let stem = name
+        .len()
+        .checked_sub(4)
+        .filter(|&n| name.is_char_boundary(n) && name[n..].eq_ignore_ascii_case(".zip"))
+        .map_or(name, |n| &name[..n]);
+    if stem.is_empty() { archive } else { stem }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::archive_stem;
+
+    #[test]
+    fn a_dropped_archive_names_its_dataset() {
+        assert_eq!(archive_stem("dishwasher.zip"), "dishwasher");
+        assert_eq!(archive_stem("objects/Range Oven.ZIP"), "Range Oven");
+        assert_eq!(archive_stem("C:\\captures\\fridge.zip"), "fridge");
+        assert_eq!(archive_stem("cabinet"), "cabinet");
+        assert_eq!(archive_stem(".zip"), ".zip");
+    }
 }

@@ -18,7 +18,9 @@ import { join } from "node:path";
 import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 import { checkSharedObjectFit, checkUrdfZip } from "./urdf.mjs";
-import { checkDemoScore, checkResultViewer } from "./result.mjs";
+import {
+  checkDemoScore, checkFinishedPanel, checkJointsTable, checkNoWarnings, checkResultViewer, checkSliderKeys,
+} from "./result.mjs";
 import { changed, snapshot } from "./canvas.mjs";
 import { checkMobileAndTouch } from "./touch.mjs";
 
@@ -330,8 +332,8 @@ try {
     const visible = await page.locator("#metrics").isVisible();
     const rows = await page.locator("#metrics tbody tr").count();
     check(visible && rows >= 3, `metrics table shown with ${rows} rows`);
-    const stage = await page.locator("#fit-stage").textContent();
-    check(stage.startsWith("finished"), `the fit panel says the fit finished (stage: ${stage})`);
+    await checkFinishedPanel({ page, check });
+    await checkNoWarnings({ page, check, what: `the ${demoPreset} demo` });
     await articulationPictures();
     await accessibility("the result view");
     await page.screenshot({ path: artefacts + "web-result.png", fullPage: true });
@@ -360,6 +362,7 @@ try {
     await writeFile(artefacts + "web-viewer-a.png", a);
     await writeFile(artefacts + "web-viewer-b.png", b);
     check(!a.equals(b), `moving #joint-0 from ${moved.from} to ${moved.to} changes the view (${moved.label})`);
+    await checkSliderKeys({ page, check });
   });
 
   // 4b. true and fitted axes, read off the viewer's pixels ---------------------------------
@@ -437,21 +440,7 @@ try {
     check(Array.isArray(joints) && joints.length === count, `joints.json lists ${joints.length} joints (sliders: ${count})`);
     const rep = JSON.parse(await readFile(saved["report.json"], "utf8"));
     check(rep && typeof rep === "object", `report.json parses (${Object.keys(rep).length} fields)`);
-    // The joints table's errors are report.json's, in the table's units (°, mm).
-    const shownErrors = await page.$$eval("#joints-table tbody tr[data-joint] td[data-metric]", (cells) =>
-      cells.map((c) => ({ joint: Number(c.parentElement.dataset.joint), metric: c.dataset.metric,
-        value: Number(c.dataset.value) })));
-    const wanted = [];
-    for (const m of rep.metrics?.joints ?? []) {
-      wanted.push({ joint: m.pred, metric: "axis_ang", value: m.axis_ang });
-      if (m.axis_pos != null) wanted.push({ joint: m.pred, metric: "axis_pos", value: m.axis_pos * 100 });
-      wanted.push({ joint: m.pred, metric: "part_motion",
-        value: m.gt_kind === "prismatic" ? m.part_motion * 1000 : m.part_motion });
-    }
-    const sameError = (w) => shownErrors.some((c) => c.joint === w.joint && c.metric === w.metric &&
-      Math.abs(c.value - w.value) <= 1e-9 * Math.max(1, Math.abs(w.value)));
-    check(wanted.length > 0 && wanted.every(sameError),
-      `the joints table shows report.json's per-joint errors (${wanted.length} values, ${shownErrors.length} shown)`);
+    await checkJointsTable({ page, check, report: rep });
     const trueRows = await page.locator("#joints-table tr.truth").count();
     check(trueRows === (rep.metrics?.joints ?? []).length && (rep.truth ?? []).length > 0,
       `each fitted joint has its true joint under it (${trueRows} rows; report.json's truth: ${(rep.truth ?? []).length})`);

@@ -3,7 +3,8 @@
 // paused, a slider or a state stops it), the part-colour legend (one entry per part, distinct
 // colours, the wasm palette's, found in the picture), the true parts' overlay (changes the
 // picture, and off restores it) and the opening view's score; no console errors meanwhile. Also the
-// page demo's score against its ground truth, for a demo at a hardware adapter's preset.
+// page demo's score against its ground truth, for a demo at a hardware adapter's preset, and the fit
+// panel at the end.
 import { writeFile } from "node:fs/promises";
 import { changed, settle, snapshot } from "./canvas.mjs";
 
@@ -157,4 +158,101 @@ export async function checkDemoScore({ page, check, preset }) {
     `the ${preset} demo types both joints right (${joints.map((j) => `${j.gt_kind}→${j.pred_kind}`).join(", ")})`);
   check(joints.length > 0 && joints.every((j) => j.axis_ang <= 2),
     `the ${preset} demo's axes are within 2° (${joints.map((j) => j.axis_ang.toFixed(2) + "°").join(", ")})`);
+}
+
+/** The fit panel once a fit is done: the stage says finished, the phase done, nothing remains, and
+ * the elapsed time is the one the status line's "Done in" gives (issue 47: they agree at the end). */
+export async function checkFinishedPanel({ page, check }) {
+  const read = (id) => page.locator(`#${id}`).textContent();
+  const [stage, phase, eta, elapsed, status] = await Promise.all(
+    ["fit-stage", "fit-phase", "fit-eta", "fit-elapsed", "fit-status"].map(read));
+  check(stage.startsWith("finished"), `the fit panel says the fit finished (stage: ${stage})`);
+  check(phase.startsWith("done"), `the fit panel's phase is done at the end (phase: ${phase})`);
+  check(!/about/.test(eta), `no time remaining is shown once the fit is done (remaining: ${eta})`);
+  const done = /Done in (.+)\./.exec(status)?.[1];
+  check(done != null && elapsed === done, `the elapsed time is the "Done in" time at the end (${elapsed}; ${status})`);
+}
+
+/** The three numbers of a "(x, y, z)" cell (and its unit after it), or null. */
+const triple = (text) => {
+  const m = /\(([^)]*)\)/.exec(text ?? "");
+  const v = m?.[1].split(",").map(Number);
+  return v?.length === 3 && v.every(Number.isFinite) ? v : null;
+};
+
+/** The joints table (issue 47): every error shown is recomputed from the two rows' own shown values
+ * within what their rounding allows, agrees with report.json where the definitions are the paper's
+ * (axis angle, line distance), and a row of the wrong type says so instead of a number. */
+export async function checkJointsTable({ page, check, report }) {
+  const rows = await page.$$eval("#joints-table tbody tr[data-joint]", (trs) => trs.map((tr) => ({
+    joint: Number(tr.dataset.joint),
+    fitted: [...tr.cells].map((c) => c.textContent),
+    values: Object.fromEntries([...tr.cells].filter((c) => c.dataset.metric).map((c) => [c.dataset.metric, c.dataset.value])),
+    truth: tr.nextElementSibling?.classList.contains("truth") ? [...tr.nextElementSibling.cells].map((c) => c.textContent) : null,
+  })));
+  const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+  const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
+  const len = (a) => Math.hypot(...a);
+  // The angle between two axes either way round (atan2 of the two products: their lengths cancel).
+  const deg = (a, b) => (Math.atan2(len(cross(a, b)), Math.abs(dot(a, b))) * 180) / Math.PI;
+  const shown = (text) => Number.parseFloat(text);
+  let recomputed = 0;
+  const problems = [];
+  for (const r of rows) {
+    const m = (report?.metrics?.joints ?? []).find((x) => x.pred === r.joint);
+    if (!r.truth || !m) continue;
+    const [, , type, axis, pivot, motion, eAxis, eLine, eMotion] = r.fitted;
+    const [, , tType, tAxis, tPivot, tMotion] = r.truth;
+    const [d, td] = [triple(axis), triple(tAxis)];
+    // Unit vectors shown to 3 decimals: each is off by at most 0.0005·√3 rad; 1-decimal display adds 0.05.
+    const axisTol = (2 * 0.0005 * Math.sqrt(3) * 180) / Math.PI + 0.05;
+    if (Math.abs(deg(d, td) - shown(eAxis)) > axisTol) problems.push(`joint ${r.joint}: axis error ${eAxis} vs ${deg(d, td).toFixed(2)}°`);
+    if (Math.abs(Number(r.values.axis_ang) - m.axis_ang) > 1e-3) problems.push(`joint ${r.joint}: axis error ≠ report's ${m.axis_ang}`);
+    recomputed++;
+    if (type !== tType) {
+      if (!/^wrong type/.test(eLine) || !/^wrong type/.test(eMotion)) problems.push(`joint ${r.joint}: a wrong type shows "${eLine}", "${eMotion}"`);
+      continue;
+    }
+    if (type === "revolute") {
+      const [o, to] = [triple(pivot), triple(tPivot)];
+      const w = o.map((x, i) => to[i] - x), n = cross(d, td), sin = len(n) / (len(d) * len(td));
+      const dist = sin < 1e-6 ? len(cross(w, d)) / len(d) : Math.abs(dot(w, n)) / len(n);
+      // Pivots shown to 0.1 mm, the directions' rounding swung over the pivots' distance from the origin.
+      const tol = 0.1 + 0.05 + 2 * 0.0005 * Math.sqrt(3) * (len(o) + len(to));
+      if (Math.abs(dist - shown(eLine)) > tol) problems.push(`joint ${r.joint}: line distance ${eLine} vs ${dist.toFixed(2)} mm`);
+      if (Math.abs(Number(r.values.axis_pos) - m.axis_pos * 100) > 1e-2) problems.push(`joint ${r.joint}: line distance ≠ report's`);
+      recomputed++;
+    }
+    const diff = Math.abs(shown(motion) - shown(tMotion));
+    if (Math.abs(diff - shown(eMotion)) > 0.1 + 0.05) problems.push(`joint ${r.joint}: motion error ${eMotion} vs ${diff.toFixed(1)}`);
+    if (!(shown(motion) >= 0)) problems.push(`joint ${r.joint}: the fitted motion ${motion} is not positive`);
+    recomputed++;
+  }
+  check(recomputed > 0 && problems.length === 0,
+    `the joints table's ${recomputed} errors follow from the rows' shown values (${problems.join("; ") || "all within rounding"})`);
+}
+
+/** The built-in demo (a clean capture of our own object) at its preset: no warning, since none is true
+ * of it (issue 47); any that appears is named in the message. */
+export async function checkNoWarnings({ page, check, what }) {
+  const items = await page.$$eval("#warnings li", (lis) => lis.map((li) => li.textContent));
+  check(items.length === 0, `${what}: no warnings (${items.join(" | ") || "none"})`);
+}
+
+/** A joint slider's keys step by a unit a reader thinks in (issue 47): 1° for a hinge, 1 mm for a
+ * slide (its label's unit), from the range's low end. */
+export async function checkSliderKeys({ page, check }) {
+  const at = await page.evaluate(() => {
+    const el = document.getElementById("joint-0");
+    if (!el) return null;
+    el.value = el.min;
+    el.dispatchEvent(new Event("input", { bubbles: true }));
+    return { min: Number(el.min), max: Number(el.max), metres: / m$/.test(el.labels?.[0]?.textContent ?? "") };
+  });
+  if (!check(at !== null, "slider #joint-0 exists for the key check")) return;
+  await page.focus("#joint-0");
+  await page.keyboard.press("ArrowRight");
+  const moved = Number(await page.inputValue("#joint-0")) - at.min;
+  const want = Math.min(at.metres ? 0.001 : 1, at.max - at.min);
+  check(Math.abs(moved - want) < 1e-9, `the right arrow moves joint 0 by ${at.metres ? "1 mm" : "1°"} (moved ${moved})`);
 }
