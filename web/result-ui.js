@@ -191,8 +191,9 @@ function showLegend() {
 
 // --- sliders ------------------------------------------------------------------------------
 
+/** A joint value as the joints table gives it: millimetres for a slide, degrees for a hinge. */
 function fmtValue(v, unit) {
-  return unit === "m" ? `${Number(v).toFixed(3)} m` : `${Number(v).toFixed(1)}°`;
+  return unit === "m" ? `${(Number(v) * 1000).toFixed(1)} mm` : `${Number(v).toFixed(1)}°`;
 }
 
 function buildSliders(joints) {

@@ -260,7 +260,7 @@ export async function checkSliderKeys({ page, check }) {
     if (!el) return null;
     el.value = el.min;
     el.dispatchEvent(new Event("input", { bubbles: true }));
-    return { min: Number(el.min), max: Number(el.max), metres: / m$/.test(el.labels?.[0]?.textContent ?? "") };
+    return { min: Number(el.min), max: Number(el.max), metres: / mm$/.test(el.labels?.[0]?.textContent ?? "") };
   });
   if (!check(at !== null, "slider #joint-0 exists for the key check")) return;
   await page.focus("#joint-0");
