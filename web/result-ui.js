@@ -457,6 +457,8 @@ export async function showResult(ViewerClass, fitResult) {
   flushDraw();
   document.body.dataset.jointCount = String(vj.length);
   document.body.dataset.result = "ready";
+  // Wide pages put the result under the fit once it is ready (style.css): bring it into view.
+  $("result").scrollIntoView?.({ behavior: "smooth", block: "start" });
   playElapsed = 0;
   if (autoplayWanted() && vj.length > 0) startPlaying();
   return { report, joints };

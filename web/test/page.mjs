@@ -19,7 +19,8 @@ import { fileURLToPath } from "node:url";
 import { serve } from "../serve.mjs";
 import { checkSharedObjectFit, checkUrdfZip } from "./urdf.mjs";
 import {
-  checkDemoScore, checkFinishedPanel, checkJointsTable, checkNoWarnings, checkResultViewer, checkSliderKeys,
+  checkDemoScore, checkFinishedPanel, checkJointsTable, checkNoWarnings, checkResultViewer, checkResultWidth,
+  checkSliderKeys,
 } from "./result.mjs";
 import { changed, snapshot } from "./canvas.mjs";
 import { checkMobileAndTouch } from "./touch.mjs";
@@ -334,6 +335,7 @@ try {
     check(visible && rows >= 3, `metrics table shown with ${rows} rows`);
     await checkFinishedPanel({ page, check });
     await checkNoWarnings({ page, check, what: `the ${demoPreset} demo` });
+    await checkResultWidth({ page, check });
     await articulationPictures();
     await accessibility("the result view");
     await page.screenshot({ path: artefacts + "web-result.png", fullPage: true });

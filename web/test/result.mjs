@@ -269,3 +269,24 @@ export async function checkSliderKeys({ page, check }) {
   const want = Math.min(at.metres ? 0.001 : 1, at.max - at.min);
   check(Math.abs(moved - want) < 1e-9, `the right arrow moves joint 0 by ${at.metres ? "1 mm" : "1°"} (moved ${moved})`);
 }
+
+/** The result at desktop widths (issue 47): the page does not scroll sideways, and the joints table
+ * fits its region without scrolling, at the test's own width and at 1280 px. */
+export async function checkResultWidth({ page, check }) {
+  const viewport = page.viewportSize();
+  try {
+    for (const width of [viewport.width, 1280]) {
+      await page.setViewportSize({ width, height: viewport.height });
+      await page.waitForTimeout(300);
+      const o = await page.evaluate(() => {
+        const table = document.getElementById("joints-table");
+        return { page: document.scrollingElement.scrollWidth, inner: window.innerWidth,
+          table: table.scrollWidth, region: table.parentElement.clientWidth };
+      });
+      check(o.page <= o.inner && o.table <= o.region + 1,
+        `${width} px wide: the result needs no sideways scrolling (page ${o.page}/${o.inner}, joints table ${o.table}/${o.region})`);
+    }
+  } finally {
+    await page.setViewportSize(viewport);
+  }
+}
