@@ -245,8 +245,9 @@ export async function checkJointsTable({ page, check, report }) {
     `the joints table's ${recomputed} errors follow from the rows' shown values (${problems.join("; ") || "all within rounding"})`);
 }
 
-/** The built-in demo (a clean capture of our own object) at its preset: no warning, since none is true
- * of it (issue 47); any that appears is named in the message. */
+/** The built-in demo (a clean capture of our own object, taken as `artmesh demo` takes it) at its
+ * preset: no warning (issue 47: it used to warn of parts "not measured" and of no test views, neither
+ * true); any that appears is named in the message. */
 export async function checkNoWarnings({ page, check, what }) {
   const items = await page.$$eval("#warnings li", (lis) => lis.map((li) => li.textContent));
   check(items.length === 0, `${what}: no warnings (${items.join(" | ") || "none"})`);
