@@ -122,6 +122,13 @@ impl GeometricJoint {
         self.observable && self.margin >= 1.0 && self.points.iter().all(|&n| n >= MIN_POINTS)
     }
 
+    /// Whether the part turned about an axis it is symmetric about: its motion does not show, but
+    /// a hinge fits decisively better than any slide (a bounded part moved along any line leaves
+    /// where it was), as a knob turned about its own axis.
+    pub fn symmetric_turn(&self) -> bool {
+        !self.observable && self.kind == JointKind::Revolute && self.type_evidence >= DECISIVE
+    }
+
     /// The hypotheses not ruled out, weakest evidence first.
     pub fn open_rivals(&self) -> impl Iterator<Item = &Alternative> {
         self.rivals.iter().flatten()

@@ -53,8 +53,7 @@ fn combined_kind(
     prismatic_loss: f64,
 ) -> JointKind {
     use crate::articulation::geometric::DECISIVE;
-    let symmetric_turn = !g.observable && g.kind == JointKind::Revolute;
-    if (g.observable || symmetric_turn) && g.type_evidence.abs() >= DECISIVE {
+    if (g.observable || g.symmetric_turn()) && g.type_evidence.abs() >= DECISIVE {
         return g.kind;
     }
     let (_, angle) = revolute.rotation.to_axis_angle();

@@ -56,7 +56,7 @@ fn flag(geometry: Option<&GeometricJoint>, measured: bool, kind: JointKind) -> O
         Some(format!(
             "its motion is not visible in the depth maps (not moving fits within {:.1} mm of either joint: a part symmetric about its axis?): {}",
             1000.0 * (g.identity_residual - g.revolute_residual.min(g.prismatic_residual)),
-            if g.kind == JointKind::Revolute && g.type_evidence >= DECISIVE {
+            if g.symmetric_turn() {
                 "a turn about its axis of symmetry, the only motion that does not show (a hinge fits decisively better than any slide); its angle comes from photometry"
             } else {
                 "type and motion come from photometry"
@@ -221,9 +221,7 @@ pub(super) fn joint_warnings(joints: &[FittedJoint], warnings: &mut Vec<String>)
         // for a turn about the part's axis of symmetry, flagged as such with its type known (a
         // hinge decisively better than any slide): a knob fitted turning 70° is no guess.
         let seen_moving = j.geometry.is_some_and(|g| g.observable);
-        let symmetric_turn = j.geometry.is_some_and(|g| {
-            !g.observable && g.kind == JointKind::Revolute && g.type_evidence >= DECISIVE
-        });
+        let symmetric_turn = j.geometry.is_some_and(|g| g.symmetric_turn());
         if ((tiny && j.initial.is_some()) || unresolved) && !seen_moving && !symmetric_turn {
             warnings.push(format!(
                 "part {} barely moves between the states (fitted {:.3} {}; not moving at all fits its two reconstructions about as well): its axis and joint type are guesses",
