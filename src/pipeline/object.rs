@@ -63,8 +63,7 @@ pub fn object_from_files(archive: &str, files: &FileSet) -> Result<ZippedObject,
     }
     if object.name.trim().is_empty() {
         // The fit's files and report are named after the object.
-        let stem = archive.rsplit('/').next().unwrap_or(archive);
-        object.name = stem.trim_end_matches(".zip").to_string();
+        object.name = archive_stem(archive).to_string();
     }
     Ok(ZippedObject {
         object,
@@ -105,7 +104,7 @@ pub async fn capture_zipped(
 
 /// The archive's file name without its folders and its `.zip`: "objects/dishwasher.zip" →
 /// "dishwasher" (the whole name when nothing is left).
-fn archive_stem(archive: &str) -> &str {
+pub fn archive_stem(archive: &str) -> &str {
     let name = archive.rsplit(['/', '\\']).next().unwrap_or(archive);
     let stem = name
         .len()

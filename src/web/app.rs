@@ -15,6 +15,7 @@ use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
 use crate::fit::observer::{BakeOffView, Command, Marks, Observer, Preview, Progress};
 use crate::gpu::now_seconds;
+use crate::pipeline::object::archive_stem;
 use crate::pipeline::preview::PREVIEW_FILE;
 use crate::pipeline::{self, FitInput, PipelineError};
 use crate::render::{RenderProgress, RenderSpec};
@@ -170,8 +171,7 @@ impl WebDataset {
     /// A dataset from a `.zip` of its folder. Throws naming the archive or the files at fault.
     pub fn from_zip(file_name: String, bytes: js_sys::Uint8Array) -> Result<WebDataset, JsError> {
         let files = read_zip(&file_name, &bytes.to_vec()).map_err(js_error)?;
-        let stem = file_name.trim_end_matches(".zip").to_string();
-        dataset_from(&files, stem)
+        dataset_from(&files, archive_stem(&file_name).to_string())
     }
 
     /// Generates the procedural `category` object with `parts` movable parts from `seed` and
