@@ -272,6 +272,5 @@ export function markFitDone() {
   text("fit-stage", "finished: every stage ran");
   text("fit-phase", "done (both phases finished)");
   text("fit-state", "both");
-  text("fit-eta", "none (done)");
   drawTimeline();
 }

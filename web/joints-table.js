@@ -3,7 +3,7 @@
 // under the table). Every joint is shown moving a positive amount, its axis the one it turns or
 // slides positively about, as a URDF whose limits start at 0 gives it; the true joint is then
 // shown the fitted way round. Degrees have one decimal, positions and lengths are in millimetres.
-import { $, fmtNum } from "./util.js";
+import { $, fmtNum, row } from "./util.js";
 
 const dot = (a, b) => a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
 const cross = (a, b) => [a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]];
@@ -28,12 +28,6 @@ const isSlide = (j) => j.type === "prismatic";
 const vec = (v, k = 1, digits = 3) => `(${v.map((x) => fmtNum(x * k, digits)).join(", ")})`;
 /** A motion in its unit: degrees for a hinge, millimetres for a slide. */
 const motionText = (j) => (isSlide(j) ? `${fmtNum(j.motion * 1000, 1)} mm` : `${fmtNum(j.motion, 1)}°`);
-
-function row(tbody, cells) {
-  const tr = tbody.insertRow();
-  for (const c of cells) tr.insertCell().textContent = c;
-  return tr;
-}
 
 /** An error cell: the text, and the number (in the shown unit) for scripts and tests. */
 function errorCell(tr, metric, value, unit, note) {

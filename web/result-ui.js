@@ -3,7 +3,7 @@
 // over the fit), the metrics table (the joints table is joints-table.js), the report's warnings and
 // the downloads.
 // Sets `document.body.dataset.result = "ready"` and `document.body.dataset.jointCount`.
-import { $, errorText, fmtNum, freeQuietly } from "./util.js";
+import { $, errorText, fmtNum, freeQuietly, row } from "./util.js";
 import { fillJoints } from "./joints-table.js";
 
 let viewer = null;
@@ -257,12 +257,6 @@ function syncSliders(sliders) {
 }
 
 // --- tables -------------------------------------------------------------------------------
-
-function row(tbody, cells) {
-  const tr = tbody.insertRow();
-  for (const c of cells) tr.insertCell().textContent = c;
-  return tr;
-}
 
 function chamfer(c) {
   if (!c) return "—";

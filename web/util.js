@@ -67,3 +67,10 @@ export function hideBanner() {
 export function freeQuietly(handle) {
   try { handle?.free?.(); } catch { /* already freed */ }
 }
+
+/** Appends a row of text cells to `tbody`; returns it. */
+export function row(tbody, cells) {
+  const tr = tbody.insertRow();
+  for (const c of cells) tr.insertCell().textContent = c;
+  return tr;
+}
