@@ -67,6 +67,10 @@ pub struct ObjectMetrics {
     pub cd_m: Option<ChamferDistance>,
     /// CD-m per matched movable part, in GT order.
     pub cd_m_parts: Vec<PartChamfer>,
+    /// Matched predicted movable parts whose mesh has no triangles (a part the fit found no
+    /// surface for): their joints are scored, but they have no CD-m.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub unsurfaced_pred: Vec<usize>,
 }
 
 fn mean(values: impl IntoIterator<Item = f64>) -> Option<f64> {
@@ -111,6 +115,9 @@ fn chamfer_labelled(
 /// paired by the joint matching (predicted movable part `i` belongs to predicted joint `i`, likewise for GT).
 /// Pass start-state meshes for the paper's protocol.
 ///
+/// A predicted movable mesh with no triangles is left out of CD-m and named in
+/// [`ObjectMetrics::unsurfaced_pred`].
+///
 /// Errors: invalid joints or meshes, or a movable mesh count different from the joint count on either side.
 pub fn evaluate_object(
     id: &str,
@@ -130,7 +137,7 @@ pub fn evaluate_object(
                 .map(|p| p.part_motion),
         )
     };
-    let (mut cd_s, mut cd_m_parts) = (None, Vec::new());
+    let (mut cd_s, mut cd_m_parts, mut unsurfaced_pred) = (None, Vec::new(), Vec::new());
     if let Some((pred_meshes, gt_meshes)) = meshes {
         for (side, m, joints) in [
             ("predicted", pred_meshes, pred_joints.len()),
@@ -154,6 +161,10 @@ pub fn evaluate_object(
             )?);
         }
         for p in pairs {
+            if pred_meshes.movable[p.pred].triangles.is_empty() {
+                unsurfaced_pred.push(p.pred);
+                continue;
+            }
             let chamfer = chamfer_labelled(
                 &pred_meshes.movable[p.pred],
                 &gt_meshes.movable[p.gt],
@@ -183,6 +194,7 @@ pub fn evaluate_object(
         cd_s,
         cd_m: mean_chamfer(&cd_m_parts),
         cd_m_parts,
+        unsurfaced_pred,
         joints: matching.pairs,
         unmatched_pred: matching.unmatched_pred,
         unmatched_gt: matching.unmatched_gt,

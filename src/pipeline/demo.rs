@@ -3,13 +3,14 @@
 
 use super::{FitInput, PipelineError};
 use crate::fit::object::FitConfig;
+use crate::fit::preset::Preset;
 use crate::gpu::GpuContext;
 use crate::object::ArticulatedObject;
 use crate::render::{CaptureError, RenderProgress, RenderSpec, capture_dataset};
 use crate::synth::{Category, SynthParams, generate};
 
-// The demo's capture follows the fit's budget but is no part of fitting: it lives here, as
-// methods on the budget so both front ends read `config.demo_capture(seed)`.
+// The demo's capture follows the fit's budget (never below `fast`'s) but is no part of fitting:
+// it lives here, as methods on the budget so both front ends read `config.full_demo_capture(seed)`.
 impl FitConfig {
     /// How a demo captures its procedural object for this budget: square images at the
     /// reconstruction's working size (32 to 512 px) and as many training views per state as it
@@ -26,18 +27,35 @@ impl FitConfig {
         }
     }
 
-    /// How `artmesh demo` captures: as a user's dataset would be, so the fit reads its working
-    /// size and its joints come from the full-resolution depth and part maps (at 64² those are
-    /// too coarse: the demo cabinet's axes came out 20.9° off) and are judged on test views.
-    /// [`FitConfig::demo_capture`] at four times the size (at most 512 px) with 4 test views.
+    /// How `artmesh demo` and the page photograph an object (the demo's or a dropped URDF), as
+    /// a user's dataset would be: the joints are measured from its full-resolution depth and part
+    /// maps and judged on its test views, while the fit reads it at its own working size. Four
+    /// times the working size (at most 512 px; full-resolution budgets get 512) with 4 test views,
+    /// and never less than the `fast` preset's capture (256², 12 training views per state),
+    /// whatever the preset: at `tiny`'s own 128² and 4 views the depth could not measure a
+    /// dropped object (habitat's kitchen counter's seven drawers came out hinges, sektion's door
+    /// 68° off), where at 256² and 12 views all three shared objects come out right within 0.4°
+    /// (`docs/results.md`, 2026-12-07); at 64² the demo cabinet's door came out 20.9° off.
     pub fn full_demo_capture(&self, seed: u64) -> RenderSpec {
-        let mut spec = self.demo_capture(seed);
-        spec.width = (4 * spec.width).min(512);
-        spec.height = spec.width;
-        spec.test_views = 4;
-        spec
+        let least = FitConfig::preset(Preset::Fast).demo_capture(seed);
+        let own = self.demo_capture(seed);
+        let size = match self.reconstruction.max_size {
+            0 => FULL_CAPTURE_MAX,
+            _ => (4 * own.width.max(least.width)).min(FULL_CAPTURE_MAX),
+        };
+        RenderSpec {
+            width: size,
+            height: size,
+            train_views: own.train_views.max(least.train_views),
+            test_views: 4,
+            ..own
+        }
     }
 }
+
+/// The largest side (px) a demo captures: a 512² view (colour, depth, part map) is 2 MB
+/// decoded, so 16 views per state are about 70 MB, which a browser tab holds easily.
+const FULL_CAPTURE_MAX: u32 = 512;
 
 /// The procedural `category` object with `movable_parts` movable parts drawn from `seed`.
 pub fn demo_object(

@@ -123,10 +123,17 @@ fn bad_inputs_are_clear_errors() {
 
     let mut empty = meshes.clone();
     empty.movable[2] = TriMesh::default();
-    let e = evaluate_object("o", "c", &joints, &joints, Some((&empty, &meshes)), &o).unwrap_err();
+    // A predicted part the fit found no surface for: its joint is scored, its CD-m is not.
+    let scored = evaluate_object("o", "c", &joints, &joints, Some((&empty, &meshes)), &o).unwrap();
+    assert_eq!(scored.unsurfaced_pred, vec![2]);
+    assert_eq!(scored.cd_m_parts.len(), joints.len() - 1);
+    assert!(scored.cd_m_parts.iter().all(|p| p.pred != 2));
+    assert_eq!(scored.joints.len(), joints.len());
+    // The same hole in the ground truth is an error: there is nothing to score against.
+    let e = evaluate_object("o", "c", &joints, &joints, Some((&meshes, &empty)), &o).unwrap_err();
     assert_eq!(
         e.to_string(),
-        "predicted movable part 2: mesh has no triangles"
+        "ground-truth movable part 2: mesh has no triangles"
     );
     let mut flat = meshes.clone();
     flat.static_part = TriMesh {

@@ -109,7 +109,7 @@ enum Command {
     /// joints.json + GLB for simulators. Reads FIT_DIR/urdf/twin.urdf and FIT_DIR/joints.json.
     Export(export::ExportArgs),
     /// Zero-set-up demo: generate the built-in object (a procedural cabinet with a drawer and a
-    /// door), capture it at 256x256 (4x the working size) with 12 views per state, fit it, score it against its ground
+    /// door), capture it at 256x256 (4x the working size, at least) with 12 views per state, fit it, score it against its ground
     /// truth and write everything (dataset, fit, metrics) to a new folder.
     Demo(demo::DemoArgs),
     /// Capture a URDF object (with its meshes) as a two-state dataset with ground truth.

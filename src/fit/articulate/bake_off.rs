@@ -20,8 +20,8 @@ use crate::gpu::{GpuResult, now_seconds};
 pub(super) struct Decision {
     pub(super) kinds: Vec<JointKind>,
     pub(super) bake_offs: Vec<BakeOff>,
-    /// The winners (the measured or seeded joint of a settled part; still for a part without
-    /// candidates).
+    /// The winners (the measured joint of a settled part, or of a measured part without a
+    /// reconstructed surface; still for a part neither trained nor measured).
     pub(super) motions: Vec<PartMotion>,
 }
 
@@ -201,19 +201,29 @@ pub(super) async fn bake_off(
             checkpoint(observer, &at).await?;
         }
     }
-    let motions: Vec<PartMotion> = (0..k)
-        .map(|p| match kinds[p] {
-            _ if !trainable[p] && !measured.settled[p] => PartMotion::IDENTITY,
-            JointKind::Revolute => candidates.revolute[p],
-            JointKind::Prismatic => candidates.prismatic[p],
-        })
-        .collect();
+    let motions = winners(&kinds, candidates, measured);
     let decision = Decision {
         kinds,
         bake_offs,
         motions,
     };
     Ok((decision, now_seconds() - t_bake))
+}
+
+/// Each part's winning motion for its decided kind. A part neither trained nor measured stays
+/// still; one the depth measured but did not settle, with no reconstructed surface to train
+/// (too small at the working size), keeps the way its depth leans (the judge flags it
+/// ambiguous) rather than standing still.
+fn winners(kinds: &[JointKind], candidates: &Candidates, measured: &Measured) -> Vec<PartMotion> {
+    kinds
+        .iter()
+        .enumerate()
+        .map(|(p, kind)| match kind {
+            _ if !candidates.trainable[p] && measured.joints[p].is_none() => PartMotion::IDENTITY,
+            JointKind::Revolute => candidates.revolute[p],
+            JointKind::Prismatic => candidates.prismatic[p],
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -313,5 +323,39 @@ mod tests {
             combined_kind(&unsure, &unsure.revolute, rot, trans),
             JointKind::Prismatic
         );
+    }
+
+    #[test]
+    fn a_measured_part_with_nothing_to_train_keeps_its_measured_motion() {
+        // Habitat's kitchen counter on the page at `tiny`: a drawer the 32² reconstruction left
+        // no surface in one state, measured leaning to a slide (z -3.2, not decisive). It stood
+        // still, 90° off, while its flag said "decided by the depth maps alone".
+        let slide = PartMotion::prismatic(DVec3::X * -0.157);
+        let drawer = GeometricJoint {
+            kind: JointKind::Prismatic,
+            prismatic: slide,
+            type_evidence: -3.2,
+            ..tied(PartMotion::revolute(DVec3::Z, DVec3::ZERO, 0.02))
+        };
+        let candidates = Candidates {
+            seeds: vec![None; 3],
+            revolute: vec![PartMotion::IDENTITY, drawer.revolute, PartMotion::IDENTITY],
+            prismatic: vec![PartMotion::IDENTITY, slide, PartMotion::IDENTITY],
+            trainable: vec![false; 3],
+        };
+        let measured = Measured {
+            train_clouds: None,
+            joints: vec![None, Some(drawer), None],
+            settled: vec![false; 3],
+        };
+        let kinds = [
+            JointKind::Revolute,
+            JointKind::Prismatic,
+            JointKind::Revolute,
+        ];
+        let won = winners(&kinds, &candidates, &measured);
+        assert_eq!(won[1], slide);
+        // Part 2, neither trained nor measured, stays where it was.
+        assert_eq!(won[2], PartMotion::IDENTITY);
     }
 }

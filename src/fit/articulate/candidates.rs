@@ -39,13 +39,12 @@ fn part_points(field: &MeshField, parts: &[u32], part: usize) -> Vec<Vec3> {
         .collect()
 }
 
-/// The reconstructions' seeds of `k` parts, a warning for each movable part without a surface
-/// in one of the states.
+/// The reconstructions' seeds of `k` parts (`None` for a movable part without a surface in one
+/// of the states).
 pub(super) fn reconstruction_seeds(
     s1: &StateReconstruction,
     s2: &StateReconstruction,
     k: usize,
-    warnings: &mut Vec<String>,
 ) -> Vec<Option<JointCandidates>> {
     (0..k)
         .map(|part| {
@@ -54,16 +53,43 @@ pub(super) fn reconstruction_seeds(
             }
             let a = part_points(&s1.field, &s1.parts, part);
             let b = part_points(&s2.field, &s2.parts, part);
-            let seeds = initial_candidates(&a, &b);
-            if seeds.is_none() {
-                let missing = if a.len() < 3 { "start" } else { "end" };
-                warnings.push(format!(
-                    "part {part} has no reconstructed surface in the {missing} state: its joint cannot be fitted and is reported as a motionless revolute joint"
-                ));
-            }
-            seeds
+            initial_candidates(&a, &b)
         })
         .collect()
+}
+
+/// A warning for each movable part the reconstruction left without a surface: without one in
+/// a state its joint comes from the depth alone, or, not measured either, cannot be fitted;
+/// without faces in the start state the twin has no mesh for it.
+pub(super) fn surface_warnings(
+    s1: &StateReconstruction,
+    seeds: &[Option<JointCandidates>],
+    measured: &Measured,
+    warnings: &mut Vec<String>,
+) {
+    for (part, seed) in seeds.iter().enumerate().skip(1) {
+        let faceless = s1
+            .part_meshes
+            .get(part)
+            .is_some_and(|m| m.triangles.is_empty());
+        let joint = match (seed, &measured.joints[part]) {
+            (Some(_), _) if !faceless => continue,
+            (Some(_), _) => "its joint is fitted",
+            (None, Some(_)) => "its joint is measured from the depth and part maps alone",
+            (None, None) => {
+                "its joint cannot be fitted and is reported as a motionless revolute joint"
+            }
+        };
+        let missing = if seed.is_none() {
+            "no surface for it in one of the states"
+        } else {
+            "no faces for it in the start state"
+        };
+        warnings.push(format!(
+            "part {part}: the reconstruction found {missing} (too small at the working size?): {joint}{}",
+            if faceless { ", and the twin has no mesh for it" } else { "" }
+        ));
+    }
 }
 
 impl Candidates {

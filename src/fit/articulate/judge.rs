@@ -152,6 +152,8 @@ pub(super) fn fitted_joints(
                 "geometry"
             } else if trainable[part] {
                 "bake-off+refined"
+            } else if geometry.is_some() {
+                "geometry (not settled; nothing to train)"
             } else {
                 "none"
             };

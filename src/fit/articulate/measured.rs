@@ -47,9 +47,6 @@ pub(super) fn measure(
         .iter()
         .map(|g| config.geometry == GeometryUse::Settle && g.is_some_and(|g| g.settled()))
         .collect();
-    if let Some(clouds) = &train_clouds {
-        unsettled_warning(clouds, &joints, warnings);
-    }
     Ok(Measured {
         train_clouds,
         joints,
@@ -59,22 +56,25 @@ pub(super) fn measure(
 
 /// Names the measured parts whose joints the depth and part maps could not settle, with the
 /// noise the depth showed: a capture too noisy to decide gets told so, not a confident guess.
-fn unsettled_warning(
-    clouds: &[ObservedState; 2],
-    joints: &[Option<GeometricJoint>],
+/// Those the photometric stages train (`trainable`) are decided there; the others (no
+/// reconstructed surface to train) keep the way their depth leans.
+pub(super) fn unsettled_warning(
+    measured: &Measured,
+    trainable: &[bool],
     warnings: &mut Vec<String>,
 ) {
-    let measured: Vec<(usize, &GeometricJoint)> = joints
-        .iter()
-        .enumerate()
-        .filter_map(|(p, g)| g.as_ref().map(|g| (p, g)))
-        .collect();
-    let open: Vec<String> = measured
-        .iter()
-        .filter(|(_, g)| !g.settled())
-        .map(|(p, _)| p.to_string())
-        .collect();
-    if open.is_empty() {
+    let Some(clouds) = &measured.train_clouds else {
+        return;
+    };
+    let parts = |train: bool| -> Vec<String> {
+        (0..measured.joints.len())
+            .filter(|&p| measured.joints[p].is_some_and(|g| !g.settled()))
+            .filter(|&p| trainable.get(p).copied().unwrap_or(false) == train)
+            .map(|p| p.to_string())
+            .collect()
+    };
+    let (photometric, leaning) = (parts(true), parts(false));
+    if photometric.is_empty() && leaning.is_empty() {
         return;
     }
     let noise = clouds[0].noise.map_or(String::new(), |n| {
@@ -84,14 +84,28 @@ fn unsettled_warning(
             n.depth
         )
     });
-    let what = if open.len() == measured.len() {
-        "the depth and part maps settle none of the joints".to_string()
+    let measured_count = measured.joints.iter().flatten().count();
+    let what = if photometric.len() + leaning.len() == measured_count {
+        "the depth and part maps settle none of the joints"
     } else {
-        "the depth and part maps do not settle every joint".to_string()
+        "the depth and part maps do not settle every joint"
     };
+    let mut how = Vec::new();
+    if !photometric.is_empty() {
+        how.push(format!(
+            "part(s) {} are decided by the photometric stages among the hypotheses the depth left open",
+            photometric.join(", ")
+        ));
+    }
+    if !leaning.is_empty() {
+        how.push(format!(
+            "part(s) {} have no reconstructed surface to train and keep the joint their depth leans to",
+            leaning.join(", ")
+        ));
+    }
     warnings.push(format!(
-        "{what}{noise}: part(s) {} are decided by the photometric stages among the hypotheses the depth left open; check any flagged below",
-        open.join(", ")
+        "{what}{noise}: {}; check any flagged below",
+        how.join("; ")
     ));
 }
 

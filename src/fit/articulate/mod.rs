@@ -60,9 +60,9 @@ use crate::data::{Dataset, State};
 use crate::gpu::{GpuContext, GpuError, GpuResult, now_seconds};
 use crate::rng::Rng;
 use bake_off::bake_off;
-use candidates::{Candidates, reconstruction_seeds, train_candidates};
+use candidates::{Candidates, reconstruction_seeds, surface_warnings, train_candidates};
 use judge::{fitted_joints, joint_warnings};
-use measured::measure;
+use measured::{measure, unsettled_warning};
 use moved_view::{MotionRenderer, MovedView};
 use refine::refine;
 use run::{Run, Schedule};
@@ -111,9 +111,11 @@ pub async fn articulate(
     let center = principal_frame(&s1.field.positions).map_or(DVec3::ZERO, |f| f.centroid);
 
     // Seeds: the reconstructions', then the measured joints where there are.
-    let seeds = reconstruction_seeds(s1, s2, k, &mut warnings);
+    let seeds = reconstruction_seeds(s1, s2, k);
     let measured = measure(dataset, config, k, rec.train_clouds.as_ref(), &mut warnings)?;
     let mut candidates = Candidates::seeded(seeds, &measured);
+    unsettled_warning(&measured, &candidates.trainable, &mut warnings);
+    surface_warnings(s1, &candidates.seeds, &measured, &mut warnings);
     times.setup_s = now_seconds() - t0;
 
     // No part left for photometry: no photometric step at all.
