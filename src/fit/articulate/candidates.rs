@@ -80,10 +80,12 @@ pub(super) fn surface_warnings(
                 "its joint cannot be fitted and is reported as a motionless revolute joint"
             }
         };
-        let missing = if seed.is_none() {
-            "no surface for it in one of the states"
-        } else {
-            "no faces for it in the start state"
+        let missing = match seed {
+            None if part_points(&s1.field, &s1.parts, part).len() < 3 => {
+                "no surface for it in the start state"
+            }
+            None => "no surface for it in the end state",
+            Some(_) => "no faces for it in the start state",
         };
         warnings.push(format!(
             "part {part}: the reconstruction found {missing} (too small at the working size?): {joint}{}",
