@@ -306,6 +306,8 @@ try {
 
   // 3. the page's demo ---------------------------------------------------------------------
   await step("browser demo", async () => {
+    // At 1280 px, the width the README's screenshots (mid-articulation, result) are taken at.
+    await page.setViewportSize({ width: 1280, height: 1100 });
     const def = await page.evaluate(() => window.artmeshCatalogue?.default ?? null);
     const category = def?.category ?? (await page.inputValue("#demo-category"));
     const nativeS = native(["demo", "--preset", demoPreset, "--category", category, "--parts", "2", "--seed", "0",
@@ -342,6 +344,7 @@ try {
     await accessibility("the result view");
     await page.screenshot({ path: artefacts + "web-result.png", fullPage: true });
     await page.locator("#result").screenshot({ path: artefacts + "web-result-section.png" });
+    await page.setViewportSize({ width: 1000, height: 1100 });
   });
 
   // 4. a slider moves a part ---------------------------------------------------------------
