@@ -24,8 +24,9 @@ const SERIES = [
   { key: "end", label: "end state", colour: "#d9730d" },
 ];
 const ARTICULATION_SERIES = [
-  { key: "candidates", label: "candidates (hinge and slide in turn)", colour: "#7a4fbf" },
-  { key: "refine", label: "refinement", colour: "#1b8a4a" },
+  { key: "hinge", label: "hinge candidates", colour: "#d9730d" },
+  { key: "slide", label: "slide candidates", colour: "#1f5fbf" },
+  { key: "refine", label: "refinement (the winners)", colour: "#1b8a4a" },
 ];
 // The timeline's entry of each phase (a state's reconstruction ends with "done" too).
 const TIMELINE = {
@@ -43,7 +44,7 @@ let dirty = false;
 let timer = null;
 let lastUpdate = 0;
 let points = {};
-let decideAt = 0;           // articulation steps before the bake-off (the candidates')
+let marks = [];             // where each stage began: {x: seconds into the fit, label, articulation}
 let timeline = {};          // seconds spent per timeline entry, and the one running
 let lastEntry = null, lastTime = 0;
 
@@ -51,12 +52,22 @@ function setFit(state) {
   document.body.dataset.fit = state;
 }
 
-/** The plot point of a progress event: its series and x (fit % or articulation step), or null. */
+/** The plot point of a progress event: its series and x (seconds into the fit), or null. The
+ *  hinge and slide candidates train on alternate steps, each its own series. */
 function plotPoint(ev) {
-  if (ev.state !== "both") return [ev.state === "end" ? "end" : "start", Number.isFinite(ev.fraction) ? ev.fraction * 100 : 0];
-  if (ev.phase === "candidates") { decideAt = Math.max(decideAt, ev.iterations ?? 0); return ["candidates", ev.iteration]; }
-  if (ev.phase === "refine") return ["refine", decideAt + ev.iteration];
+  const x = Number(ev.elapsed_s) || 0;
+  if (ev.state !== "both") return [ev.state === "end" ? "end" : "start", x];
+  if (ev.phase === "candidates" && ev.candidate) return [ev.candidate, x];
+  if (ev.phase === "refine") return ["refine", x];
   return null;
+}
+
+/** A mark on the plots where a stage (or a state's reconstruction) begins. */
+function markStage(ev, entry) {
+  const label = entry === "reconstruction" ? `${ev.state} state` : entry;
+  const last = marks[marks.length - 1];
+  if (last?.label === label) return;
+  marks.push({ x: Number(ev.elapsed_s) || 0, label, articulation: ev.state === "both" });
 }
 
 /** Charges the time since the last event to the timeline entry that was running. */
@@ -66,6 +77,7 @@ function tick(ev) {
   lastTime = now;
   lastEntry = TIMELINE[ev.phase] ?? (ev.state === "both" ? null : lastEntry);
   if (lastEntry) timeline[lastEntry] ??= 0;
+  if (lastEntry) markStage(ev, lastEntry);
   if (ev.phase === "candidates" && ev.iterations === 0) timeline.noSteps = true;
 }
 
@@ -145,11 +157,18 @@ function update() {
     }
   }
   drawTimeline();
+  const xLabel = "seconds into the fit";
   drawLogPlot($("loss-plot"), SERIES.map((s) => ({ ...s, points: points[s.key] ?? [] })),
-    { xLabel: "progress of the whole fit (%)", xMax: 100 });
+    { xLabel, marks: marks.filter((m) => !m.articulation) });
   const articulated = ARTICULATION_SERIES.map((s) => ({ ...s, points: points[s.key] ?? [] }));
+  // What the plots hold, for tests and assistive tools: each series' point count and the marks.
+  document.body.dataset.plotSeries = [...SERIES, ...ARTICULATION_SERIES]
+    .map((s) => `${s.key}:${points[s.key]?.length ?? 0}`).join(",");
+  document.body.dataset.plotMarks = marks.map((m) => m.label).join(",");
   $("articulation-plot").hidden = !articulated.some((s) => s.points.length > 0);
-  if (!$("articulation-plot").hidden) drawLogPlot($("articulation-plot"), articulated, { xLabel: "articulation step" });
+  if (!$("articulation-plot").hidden) {
+    drawLogPlot($("articulation-plot"), articulated, { xLabel, marks: marks.filter((m) => m.articulation) });
+  }
   const p = latestPreview;
   if (p) {
     latestPreview = null;
@@ -166,7 +185,7 @@ function update() {
 
 function resetPanel() {
   latest = null; latestPreview = null; points = {};
-  decideAt = 0; timeline = {}; lastEntry = null; lastTime = performance.now() / 1000;
+  marks = []; timeline = {}; lastEntry = null; lastTime = performance.now() / 1000;
   resetArticulation();
   for (const id of ["fit-stage", "fit-phase", "fit-state", "fit-iter", "fit-elapsed", "fit-eta", "fit-faces", "fit-vertices"]) text(id, "—");
   text("preview-caption", "");

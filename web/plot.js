@@ -25,8 +25,26 @@ function linearTicks(a, b) {
   return ticks;
 }
 
-/** Draws `series` with labelled axes: `xLabel` under the x ticks, `yLabel` up the left side. */
-export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log scale)", xMax = null } = {}) {
+/** Log ticks over [ly0, ly1] (log10 units): powers of ten, then 2× and 5×, then finer, until at
+ *  least two fall in the range, so the axis always has a scale to read. */
+function logTicks(ly0, ly1) {
+  for (const mults of [[1], [1, 2, 5], [1, 1.5, 2, 3, 5, 7]]) {
+    const ticks = [];
+    for (let e = Math.floor(ly0); e <= Math.ceil(ly1); e++) {
+      for (const m of mults) {
+        const v = m * 10 ** e, lv = Math.log10(v);
+        if (lv >= ly0 && lv <= ly1) ticks.push(v);
+      }
+    }
+    if (ticks.length >= 2 && (mults.length > 1 || ly1 - ly0 >= 1.5)) return ticks;
+  }
+  // A range narrower than the finest steps: its two ends.
+  return [10 ** ly0, 10 ** ly1].map((v) => Number(v.toPrecision(3)));
+}
+
+/** Draws `series` with labelled axes: `xLabel` under the x ticks, `yLabel` up the left side;
+ *  `marks` ([{x, label}]) as grey vertical lines labelled where each stage began. */
+export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log scale)", xMax = null, marks = [] } = {}) {
   const [w, h, dpr] = fitCanvas(canvas);
   const ctx = canvas.getContext("2d");
   ctx.setTransform(1, 0, 0, 1, 0, 0);
@@ -59,22 +77,27 @@ export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log s
   const X = (x) => pad.l + ((x - x0) / (x1 - x0)) * pw;
   const Y = (y) => pad.t + (1 - (Math.log10(y) - ly0) / (ly1 - ly0)) * ph;
 
-  // y ticks: powers of ten (and 2×, 5× when the range is short).
+  // y ticks: at least two, labelled.
   ctx.fillStyle = "#4a5560";
   ctx.textAlign = "right";
   ctx.textBaseline = "middle";
-  const decades = ly1 - ly0;
-  const mults = decades < 1.5 ? [1, 2, 5] : [1];
-  for (let e = Math.floor(ly0); e <= Math.ceil(ly1); e++) {
-    for (const m of mults) {
-      const v = m * 10 ** e, lv = Math.log10(v);
-      if (lv < ly0 || lv > ly1) continue;
-      const y = Y(v);
-      ctx.strokeStyle = "#e4e9ee";
-      ctx.beginPath(); ctx.moveTo(pad.l, y); ctx.lineTo(pad.l + pw, y); ctx.stroke();
-      ctx.fillText(fmtTick(v), pad.l - 4, y);
-    }
+  for (const v of logTicks(ly0, ly1)) {
+    const y = Y(v);
+    ctx.strokeStyle = "#e4e9ee";
+    ctx.beginPath(); ctx.moveTo(pad.l, y); ctx.lineTo(pad.l + pw, y); ctx.stroke();
+    ctx.fillText(fmtTick(v), pad.l - 4, y);
   }
+  // Stage marks: a grey line and the stage's name at the top of the plot area.
+  ctx.textAlign = "left";
+  ctx.textBaseline = "top";
+  for (const m of marks) {
+    if (!(m.x >= x0 && m.x <= x1)) continue;
+    ctx.strokeStyle = "#b7c0c9";
+    ctx.beginPath(); ctx.moveTo(X(m.x), pad.t); ctx.lineTo(X(m.x), pad.t + ph); ctx.stroke();
+    ctx.fillStyle = "#6b7680";
+    ctx.fillText(m.label, X(m.x) + 3, pad.t + 3);
+  }
+  ctx.fillStyle = "#4a5560";
   ctx.textAlign = "center";
   ctx.textBaseline = "top";
   for (const v of linearTicks(x0, x1)) {

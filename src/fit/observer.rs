@@ -75,6 +75,9 @@ pub struct Progress {
     pub faces: usize,
     /// Seconds since this state's reconstruction began.
     pub elapsed_s: f64,
+    /// In the candidates stage, whose step this was: the hinge and the slide candidates train
+    /// on alternate steps, so their losses are two curves, not one.
+    pub candidate: Option<JointKind>,
 }
 
 impl Progress {

@@ -280,6 +280,13 @@ impl Observer for PageObserver {
             ("elapsed_s", number(elapsed)),
             ("fraction", number(fraction)),
             ("eta_s", opt(eta)),
+            (
+                "candidate",
+                e.candidate.map_or(JsValue::NULL, |k| match k {
+                    JointKind::Revolute => "hinge".into(),
+                    JointKind::Prismatic => "slide".into(),
+                }),
+            ),
         ]));
     }
 

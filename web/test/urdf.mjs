@@ -132,6 +132,10 @@ export async function checkSharedObjectFit({ page, check, work, artefacts, prese
     console.log(`note ${object.name} (${preset}): ${seconds.toFixed(1)} s, Axis Ang ` +
       joints.map((j) => j.axis_ang.toFixed(2) + "°").join(" ") + `; warnings: ${warnings.join(" | ") || "none"}`);
     if (object.name === "fridge") await checkTruthOverlay({ page, check, artefacts });
+    if (scored.trained) {
+      checkArticulationPlot(check, object.name, scored.plot);
+      await page.locator("#fit").screenshot({ path: artefacts + `web-urdf-${object.name}-fit.png` });
+    }
   }
   const mean = axes.reduce((a, x) => a + x, 0) / Math.max(axes.length, 1);
   check(axes.length === SHARED_OBJECTS.length && mean <= bounds.meanAxisDeg,
@@ -166,7 +170,10 @@ async function fitShared({ page, check, object, zipPath, preset, work }) {
   const last = await page.evaluate(() => window.artmeshLast ?? null);
   const report = typeof last?.report === "string" ? JSON.parse(last.report) : last?.report;
   writeFileSync(join(work, `${object.name}-report.json`), JSON.stringify(report ?? null));
-  return { joints: report?.metrics?.joints ?? [], seconds, warnings: report?.warnings ?? [] };
+  const plot = await page.evaluate(() => ({ series: document.body.dataset.plotSeries, marks: document.body.dataset.plotMarks }));
+  // The photometric stages ran: the articulation's curve has points.
+  const trained = (report?.articulation?.curve ?? []).length > 0;
+  return { joints: report?.metrics?.joints ?? [], seconds, warnings: report?.warnings ?? [], plot, trained };
 }
 
 /** The fitted object's result: scored in the metrics table, and the true-parts toggle changes
@@ -187,4 +194,15 @@ async function checkTruthOverlay({ page, check, artefacts }) {
   check(!before.equals(after), "the true parts overlay the fitted fridge (the viewer's picture changes)");
   await page.locator("#result").screenshot({ path: artefacts + "web-urdf-result-truth.png" });
   await page.uncheck("#show-truth-parts");
+}
+
+/** Where the photometric stages ran, the articulation plot shows the hinge and the slide candidates as
+ *  two series and the refinement as a third, and marks where the bake-off and the refinement began
+ *  (issue 47: a student can read it). */
+function checkArticulationPlot(check, name, plot) {
+  const counts = Object.fromEntries((plot.series ?? "").split(",").map((e) => e.split(":")).map(([k, n]) => [k, Number(n)]));
+  const marks = (plot.marks ?? "").split(",");
+  check(counts.hinge > 0 && counts.slide > 0 && counts.refine > 0 &&
+    ["candidates", "bake-off", "refinement"].every((m) => marks.includes(m)),
+  `${name}: the articulation plot has hinge, slide and refinement series (${plot.series}) and marks each stage (${plot.marks})`);
 }

@@ -13,7 +13,7 @@ use super::run::Run;
 use crate::articulation::init::{JointCandidates, initial_candidates};
 use crate::articulation::{MotionAdam, MotionMask, PartMotion, PartSums};
 use crate::data::JointKind;
-use crate::fit::observer::{Observer, Phase, checkpoint};
+use crate::fit::observer::{Observer, Phase, Progress, checkpoint};
 use crate::fit::reconstruct::StateReconstruction;
 use crate::gpu::{GpuResult, now_seconds};
 use crate::raster::MeshField;
@@ -179,7 +179,10 @@ pub(super) async fn train_candidates(
             );
             adam.step(part, &mut motions[part], &g, MotionMask::of(kind));
         }
-        if (i + 1).is_multiple_of(config.report_every.max(1)) || i + 1 == decide {
+        // Both candidates are reported, from consecutive steps: the hinge's and the slide's.
+        let every = config.report_every.max(1);
+        let reported = (i + 1).is_multiple_of(every) || (i + 2).is_multiple_of(every);
+        if reported || i + 2 >= decide {
             let terms = run.forward.loss.read_terms(ctx).await?;
             run.curve.push(ArticulationPoint {
                 iteration: i,
@@ -188,7 +191,10 @@ pub(super) async fn train_candidates(
                 backward_loss: None,
                 vertex_loss: None,
             });
-            let at = run.event(Phase::Candidates, i + 1, decide, Some(terms.total));
+            let at = Progress {
+                candidate: Some(kind),
+                ..run.event(Phase::Candidates, i + 1, decide, Some(terms.total))
+            };
             checkpoint(observer, &at).await?;
             if observer.wants_preview() {
                 let by = if is_rot {

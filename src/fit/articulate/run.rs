@@ -77,6 +77,7 @@ impl Run<'_> {
             vertices: self.sizes.0,
             faces: self.sizes.1,
             elapsed_s: now_seconds() - self.t0,
+            candidate: None,
         }
     }
 }

@@ -58,6 +58,7 @@ impl StateRun<'_> {
             vertices: sizes.0,
             faces: sizes.1,
             elapsed_s: now_seconds() - self.t0,
+            candidate: None,
         }
     }
 
