@@ -91,10 +91,13 @@ async function gpuSection() {
   // the address asks for a preset.
   const tiny = software && !params.get("preset") && choosePreset("tiny");
   document.body.dataset.software = String(software);
-  show($("adapter"), `${name} (${software ? "software" : "hardware"} WebGPU)\n` +
-    `largest storage binding ${(adapter.max_storage_buffer_binding_size / 2 ** 20).toFixed(0)} MiB, ` +
-    `${adapter.max_compute_workgroups_per_dimension} workgroups per dimension` +
-    (software ? `\nA software adapter is slow: ${tiny ? "the tiny preset is chosen (a fast fit would take many minutes)" : "use the tiny preset"}.` : ""), "ok");
+  const limits = `Details: the largest buffer the fit may use is ${(adapter.max_storage_buffer_binding_size / 2 ** 20).toFixed(0)} MiB; ` +
+    `up to ${adapter.max_compute_workgroups_per_dimension} workgroups per dimension.`;
+  show($("adapter"), software
+    ? `No graphics card is available to this page, so the browser emulates one on the processor (${name}). ` +
+      `Fits run, but slowly: ${tiny ? "the tiny preset is chosen for you" : "the tiny preset is the one to use"} ` +
+      `(a fast fit can take several minutes here).\n${limits}`
+    : `The fit runs on your graphics card: ${name}.\n${limits}`, "ok");
   gpuOk = true;
   return true;
 }
