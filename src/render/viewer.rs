@@ -411,11 +411,17 @@ impl TruthParts {
     }
 }
 
-/// How much of the true parts' ghost shows: a see-through fill, and an outline round each true
-/// part (where its part id changes) so its shape reads over any colour; each fainter where the
-/// fitted surface is in front, so a hidden true part still reads without hiding the fit.
-const GHOST_FILL: [f32; 2] = [0.35, 0.15];
+/// How much of the true parts' ghost shows: a hatched see-through fill, and an outline round
+/// each true part (where its part id changes) so its shape reads over any colour; each fainter
+/// where the fitted surface is in front, so a hidden true part still reads without hiding the fit.
+const GHOST_FILL: [f32; 2] = [0.6, 0.3];
 const GHOST_OUTLINE: [f32; 2] = [1.0, 0.5];
+
+/// The fill is hatched: diagonal stripes this many pixels wide, every other one ghosted. A dark
+/// see-through fill alone reads as shading on a grey object (issue 47: the ghost could not be
+/// told apart on grey objects); stripes read as the ghost over a surface of any colour, and the
+/// fitted surface shows between them.
+const HATCH_PX: usize = 3;
 
 /// Lays the true parts' render `truth` over the fitted twin's `fitted` (same camera and size):
 /// the truth's colour at [`GHOST_FILL`] inside a part and [`GHOST_OUTLINE`] on its outline, the
@@ -453,8 +459,10 @@ pub fn ghost_over(fitted: &RenderedView, truth: &RenderedView) -> RgbaImage {
         let behind = !empty && truth.depth_metres[i] > fitted.depth_metres[i];
         let shares = if outline(i) {
             GHOST_OUTLINE
-        } else {
+        } else if ((i % w + i / w) / HATCH_PX).is_multiple_of(2) {
             GHOST_FILL
+        } else {
+            continue;
         };
         let a = shares[usize::from(behind)];
         for c in 0..3 {

@@ -186,7 +186,8 @@ impl Viewer {
         self.scene.borrow().has_truth_parts()
     }
 
-    /// Lays the true parts over the fitted twin as a see-through dark ghost, articulated along.
+    /// Lays the true parts over the fitted twin as a hatched, see-through dark ghost, articulated
+    /// along.
     pub fn show_truth_parts(&self, on: bool) {
         self.scene.borrow_mut().show_truth_parts = on;
     }

@@ -63,7 +63,7 @@ function native(args) {
   return (performance.now() - t0) / 1000;
 }
 
-// ARTMESH_PAGE_STEPS: only these steps (comma-separated; the GPU self-test, which opens the page, always runs).
+// ARTMESH_PAGE_STEPS: only these steps (comma-separated names, so none has a comma; the GPU self-test, which opens the page, always runs).
 const onlySteps = process.env.ARTMESH_PAGE_STEPS?.split(",").map((s) => s.trim());
 const timings = [];
 async function step(name, fn) {
@@ -398,7 +398,7 @@ try {
     check(dark > 30, `the true axes are drawn, in black (${dark} dark pixels go with them)`);
     check(coloured > 30, `the fitted axes are drawn, in colour (${coloured} coloured pixels go with them)`);
   });
-  await step("play, legend and true parts", () => checkResultViewer({ page, check, artefacts }));
+  await step("result viewer", () => checkResultViewer({ page, check, artefacts }));
   await step("phone width and touch", () => checkMobileAndTouch({ page, browser, url, check, native, work, artefacts }));
 
   // 5. downloads ---------------------------------------------------------------------------

@@ -279,3 +279,64 @@ fn the_ghost_shows_through_more_in_front_than_behind_and_outlines_parts() {
     assert_eq!(ghost_over(&fitted, &big), fitted.rgba);
     assert_ne!(ghost_over(&fitted, &small), fitted.rgba);
 }
+
+#[test]
+fn the_hatched_ghost_reads_over_any_grey() {
+    // A true part in front of a grey fitted surface, light to dark: inside the part, the ghosted
+    // stripes differ from the bare ones between them by a lightness step anyone sees (ΔL* ≥ 10;
+    // 2 is a just-noticeable one), whatever the grey.
+    let lightness = |v: u8| {
+        let c = f32::from(v) / 255.0;
+        let y = if c <= 0.04045 {
+            c / 12.92
+        } else {
+            ((c + 0.055) / 1.055).powf(2.4)
+        };
+        116.0 * y.cbrt() - 16.0
+    };
+    for grey in [40u8, 90, 128, 200, 240] {
+        let n = 12;
+        let fitted = RenderedView {
+            rgba: RgbaImage {
+                width: n,
+                height: n,
+                pixels: [grey, grey, grey, 255].repeat(144),
+            },
+            depth: crate::data::DepthMap {
+                width: n,
+                height: n,
+                millimetres: vec![1000; 144],
+            },
+            parts: crate::data::PartMap {
+                width: n,
+                height: n,
+                ids: vec![1; 144],
+            },
+            depth_metres: vec![1.0; 144],
+        };
+        let truth = RenderedView {
+            rgba: RgbaImage {
+                width: n,
+                height: n,
+                pixels: [5, 5, 8, 255].repeat(144),
+            },
+            depth_metres: vec![0.9; 144],
+            ..fitted.clone()
+        };
+        let out = ghost_over(&fitted, &truth);
+        let inside: Vec<u8> = (1..n as usize - 1)
+            .flat_map(|y| (1..n as usize - 1).map(move |x| y * n as usize + x))
+            .map(|i| out.pixels[4 * i])
+            .collect();
+        let (lo, hi) = (*inside.iter().min().unwrap(), *inside.iter().max().unwrap());
+        assert_eq!(
+            hi, grey,
+            "grey {grey}: bare stripes show the fitted surface"
+        );
+        let step = lightness(hi) - lightness(lo);
+        assert!(
+            step >= 10.0,
+            "grey {grey}: stripes only ΔL* {step:.1} apart"
+        );
+    }
+}
