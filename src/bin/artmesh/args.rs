@@ -127,8 +127,9 @@ pub struct BudgetArgs {
     /// edge lengths of each other (0: none) [default: 3].
     #[arg(long)]
     rim_gap: Option<f32>,
-    /// Decimate the exported twin's visual meshes to at most this many faces over all parts (0: no
-    /// limit) [default: 100000].
+    /// Decimate the exported twin's visual meshes towards this many faces over all parts, each part
+    /// its share (0: no limit) [default: 100000]. A target, not a cap: an edge collapse that would
+    /// break a surface or flip a face is not made, so a part may keep more faces than its share.
     #[arg(long)]
     max_visual_faces: Option<usize>,
 }
