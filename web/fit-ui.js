@@ -76,8 +76,10 @@ function tick(ev) {
   if (lastEntry) timeline[lastEntry] = (timeline[lastEntry] ?? 0) + now - lastTime;
   lastTime = now;
   lastEntry = TIMELINE[ev.phase] ?? (ev.state === "both" ? null : lastEntry);
-  if (lastEntry) timeline[lastEntry] ??= 0;
-  if (lastEntry) markStage(ev, lastEntry);
+  if (lastEntry) {
+    timeline[lastEntry] ??= 0;
+    markStage(ev, lastEntry);
+  }
   if (ev.phase === "candidates" && ev.iterations === 0) timeline.noSteps = true;
 }
 

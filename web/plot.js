@@ -44,7 +44,7 @@ function logTicks(ly0, ly1) {
 
 /** Draws `series` with labelled axes: `xLabel` under the x ticks, `yLabel` up the left side;
  *  `marks` ([{x, label}]) as grey vertical lines labelled where each stage began. */
-export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log scale)", xMax = null, marks = [] } = {}) {
+export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log scale)", marks = [] } = {}) {
   const [w, h, dpr] = fitCanvas(canvas);
   const ctx = canvas.getContext("2d");
   ctx.setTransform(1, 0, 0, 1, 0, 0);
@@ -69,7 +69,6 @@ export function drawLogPlot(canvas, series, { xLabel = "", yLabel = "loss (log s
     ctx.fillText("waiting for the first loss…", pad.l + 8, pad.t + 16);
     return;
   }
-  if (xMax != null) { x0 = Math.min(x0, 0); x1 = Math.max(x1, xMax); }
   if (x1 <= x0) x1 = x0 + 1;
   let ly0 = Math.log10(y0), ly1 = Math.log10(y1);
   if (ly1 - ly0 < 0.3) { const m = (ly0 + ly1) / 2; ly0 = m - 0.15; ly1 = m + 0.15; }

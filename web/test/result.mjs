@@ -148,11 +148,16 @@ export async function checkResultViewer({ page, check, artefacts }) {
   check(errors.length === 0, `no console errors in the result viewer checks (${errors.join(" | ") || "none"})`);
 }
 
+/** The last fit's report.json as the page keeps it (`window.artmeshLast`), parsed; null before one. */
+export async function lastReport(page) {
+  const last = await page.evaluate(() => window.artmeshLast ?? null);
+  return typeof last?.report === "string" ? JSON.parse(last.report) : last?.report ?? null;
+}
+
 /** The page demo's joints against its ground truth (report.json's metrics): both types right and
  * every axis within 2°, what a demo at a hardware adapter's preset must give (issue 46). */
 export async function checkDemoScore({ page, check, preset }) {
-  const last = await page.evaluate(() => window.artmeshLast ?? null);
-  const report = typeof last?.report === "string" ? JSON.parse(last.report) : last?.report;
+  const report = await lastReport(page);
   const joints = report?.metrics?.joints ?? [];
   check(joints.length === 2 && joints.every((j) => j.type_correct),
     `the ${preset} demo types both joints right (${joints.map((j) => `${j.gt_kind}→${j.pred_kind}`).join(", ")})`);

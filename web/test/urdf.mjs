@@ -7,18 +7,26 @@ import { execFileSync } from "node:child_process";
 import { existsSync, readdirSync, readFileSync, writeFileSync } from "node:fs";
 import { fileURLToPath } from "node:url";
 import { join } from "node:path";
+import { lastReport } from "./result.mjs";
 
-// Zips `root` under `folder/`, leaving out paths for which `skip(relative path)` is true.
+// Zips `root` under `folder/`: the files and folders named after `skip` (relative to `root`; all of
+// it when none are named), leaving out the one path `skip`.
 const ZIP_PY = [
   "import os, sys, zipfile",
   "root, out, folder, skip = sys.argv[1], sys.argv[2], sys.argv[3], sys.argv[4]",
   "with zipfile.ZipFile(out, 'w', zipfile.ZIP_DEFLATED) as z:",
-  "    for d, _, files in sorted(os.walk(root)):",
-  "        for f in sorted(files):",
-  "            p = os.path.join(d, f)",
+  "    for top in [os.path.join(root, r) for r in sys.argv[5:] or ['.']]:",
+  "        paths = [os.path.join(d, f) for d, _, fs in os.walk(top) for f in fs] if os.path.isdir(top) else [top]",
+  "        for p in sorted(paths):",
   "            rel = os.path.relpath(p, root).replace(os.sep, '/')",
   "            if rel != skip: z.write(p, folder + '/' + rel)",
 ].join("\n");
+
+/** Zips `root` into `path` under `folder/` with ZIP_PY: `only` its paths (all when empty), less `skip`. */
+function zipFolder(root, path, folder, { skip = "", only = [] } = {}) {
+  execFileSync("python3", ["-c", ZIP_PY, root, path, folder, skip, ...only], { stdio: ["ignore", "ignore", "inherit"] });
+  return path;
+}
 
 /** Runs the check on `page` (the page loaded, no GPU job running); `check(ok, what)` records,
  *  `native(args)` runs the CLI, `work` is a scratch folder. */
@@ -30,11 +38,7 @@ export async function checkUrdfZip({ page, check, native, work }) {
   // A mesh the URDF refers to (meshes/ also holds .mtl files and textures).
   const mesh = readFileSync(join(root, urdf), "utf8").match(/filename="([^"]+\.obj)"/)?.[1];
   if (!check(Boolean(mesh), `the synthesised URDF refers to a mesh (${mesh})`)) return;
-  const zip = (name, skip) => {
-    const path = join(work, name);
-    execFileSync("python3", ["-c", ZIP_PY, root, path, "laptop", skip], { stdio: ["ignore", "ignore", "inherit"] });
-    return path;
-  };
+  const zip = (name, skip) => zipFolder(root, join(work, name), "laptop", { skip });
   const good = zip("laptop-urdf.zip", ""), broken = zip("laptop-no-mesh.zip", mesh);
   const flags = () => page.evaluate(() => ({ ...document.body.dataset }));
   const reset = () => page.evaluate(() => {
@@ -103,17 +107,7 @@ const timed = process.env.ARTMESH_PAGE_TIMED === "1";
 
 /** Zips `object` (one of `SHARED_OBJECTS`) from `root` into `work`; the archive's path. */
 function zipShared(object, root, work) {
-  const path = join(work, `${object.name}.zip`);
-  execFileSync("python3", ["-c", [
-    "import os, sys, zipfile",
-    "out, root, folder = sys.argv[1], sys.argv[2], sys.argv[3]",
-    "with zipfile.ZipFile(out, 'w', zipfile.ZIP_DEFLATED) as z:",
-    "    for rel in sys.argv[4:]:",
-    "        p = os.path.join(root, rel)",
-    "        names = [os.path.join(d, f) for d, _, fs in os.walk(p) for f in fs] if os.path.isdir(p) else [p]",
-    "        for n in sorted(names): z.write(n, folder + '/' + os.path.relpath(n, root))",
-  ].join("\n"), path, join(root, object.dir), object.name, ...object.files]);
-  return path;
+  return zipFolder(join(root, object.dir), join(work, `${object.name}.zip`), object.name, { only: object.files });
 }
 
 /** The shared objects (`SHARED_OBJECTS`), zipped, picked as a .zip, photographed and fitted at
@@ -172,8 +166,7 @@ async function fitShared({ page, check, object, zipPath, preset, work }) {
   if (!check(fit.fit === "done", `${object.name} is fitted in the page in ${seconds.toFixed(1)} s ` +
     `(fit=${fit.fit}${fit.fitError ? ": " + fit.fitError : ""})`)) return null;
   await page.waitForFunction(() => document.body.dataset.result === "ready", null, { timeout: 120_000 });
-  const last = await page.evaluate(() => window.artmeshLast ?? null);
-  const report = typeof last?.report === "string" ? JSON.parse(last.report) : last?.report;
+  const report = await lastReport(page);
   writeFileSync(join(work, `${object.name}-report.json`), JSON.stringify(report ?? null));
   const plot = await page.evaluate(() => ({ series: document.body.dataset.plotSeries, marks: document.body.dataset.plotMarks }));
   // The photometric stages ran: the articulation's curve has points.

@@ -37,7 +37,7 @@ fn encode(linear: f32) -> f32 {
 }
 
 /// sRGB → linear of one channel byte.
-fn decode(byte: u8) -> f32 {
+pub(super) fn decode(byte: u8) -> f32 {
     let s = byte as f32 / 255.0;
     if s <= 0.040_45 {
         s / 12.92

@@ -228,29 +228,34 @@ fn the_true_parts_follow_the_sliders_and_states() {
     assert!(s.truth_meshes().is_empty());
 }
 
-/// A 3 × 3 render of one colour at one depth (part 1, or none where transparent): its centre
-/// is inside the part, the rest on its outline.
-fn view(rgba: [u8; 4], depth: f32) -> RenderedView {
-    let (w, h) = (3, 3);
+/// An `n` × `n` render of one colour at one depth (part 1, or none where transparent): its
+/// border is the part's outline, the rest inside it.
+fn square_view(n: u32, rgba: [u8; 4], depth: f32) -> RenderedView {
     let id = if rgba[3] == 0 { -1 } else { 1 };
+    let count = (n * n) as usize;
     RenderedView {
         rgba: RgbaImage {
-            width: w,
-            height: h,
-            pixels: rgba.repeat(9),
+            width: n,
+            height: n,
+            pixels: rgba.repeat(count),
         },
         depth: crate::data::DepthMap {
-            width: w,
-            height: h,
-            millimetres: vec![(depth * 1000.0) as u16; 9],
+            width: n,
+            height: n,
+            millimetres: vec![(depth * 1000.0) as u16; count],
         },
         parts: crate::data::PartMap {
-            width: w,
-            height: h,
-            ids: vec![id; 9],
+            width: n,
+            height: n,
+            ids: vec![id; count],
         },
-        depth_metres: vec![depth; 9],
+        depth_metres: vec![depth; count],
     }
+}
+
+/// A 3 × 3 [`square_view`]: its centre is inside the part, the rest on its outline.
+fn view(rgba: [u8; 4], depth: f32) -> RenderedView {
+    square_view(3, rgba, depth)
 }
 
 #[test]
@@ -285,47 +290,14 @@ fn the_hatched_ghost_reads_over_any_grey() {
     // A true part in front of a grey fitted surface, light to dark: inside the part, the ghosted
     // stripes differ from the bare ones between them by a lightness step anyone sees (ΔL* ≥ 10;
     // 2 is a just-noticeable one), whatever the grey.
-    let lightness = |v: u8| {
-        let c = f32::from(v) / 255.0;
-        let y = if c <= 0.04045 {
-            c / 12.92
-        } else {
-            ((c + 0.055) / 1.055).powf(2.4)
-        };
-        116.0 * y.cbrt() - 16.0
-    };
+    let lightness = |v: u8| palette::lab([palette::decode(v); 3])[0];
+    let n = 12;
     for grey in [40u8, 90, 128, 200, 240] {
-        let n = 12;
-        let fitted = RenderedView {
-            rgba: RgbaImage {
-                width: n,
-                height: n,
-                pixels: [grey, grey, grey, 255].repeat(144),
-            },
-            depth: crate::data::DepthMap {
-                width: n,
-                height: n,
-                millimetres: vec![1000; 144],
-            },
-            parts: crate::data::PartMap {
-                width: n,
-                height: n,
-                ids: vec![1; 144],
-            },
-            depth_metres: vec![1.0; 144],
-        };
-        let truth = RenderedView {
-            rgba: RgbaImage {
-                width: n,
-                height: n,
-                pixels: [5, 5, 8, 255].repeat(144),
-            },
-            depth_metres: vec![0.9; 144],
-            ..fitted.clone()
-        };
-        let out = ghost_over(&fitted, &truth);
-        let inside: Vec<u8> = (1..n as usize - 1)
-            .flat_map(|y| (1..n as usize - 1).map(move |x| y * n as usize + x))
+        let fitted = square_view(n, [grey, grey, grey, 255], 1.0);
+        let out = ghost_over(&fitted, &square_view(n, [5, 5, 8, 255], 0.9));
+        let n = n as usize;
+        let inside: Vec<u8> = (1..n - 1)
+            .flat_map(|y| (1..n - 1).map(move |x| y * n + x))
             .map(|i| out.pixels[4 * i])
             .collect();
         let (lo, hi) = (*inside.iter().min().unwrap(), *inside.iter().max().unwrap());
