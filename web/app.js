@@ -6,9 +6,9 @@ import { $, show, errorText, showBanner, hideBanner, freeQuietly } from "./util.
 import { setupInput, showDataset } from "./input.js";
 import { wireFitButtons, runFit, markFitDone } from "./fit-ui.js";
 import { wireResultButtons, showResult, clearResult } from "./result-ui.js";
-import { setupBudgets, showPresetBudget, budgetOverrides } from "./budget-ui.js";
+import { setupBudgets, showPresetBudget, budgetOverrides, shownPreset } from "./budget-ui.js";
 import { setPartColours } from "./articulation-ui.js";
-import { estimateText, recordFit } from "./estimate.js";
+import { Eta, estimate, estimateText, photographSeconds } from "./estimate.js";
 
 const params = new URLSearchParams(location.search);
 const maxSize = Number(params.get("max") ?? 1000003);
@@ -160,6 +160,36 @@ function choosePreset(name) {
 const describers = [];
 const describePresets = () => describers.forEach((f) => f());
 
+/** What a fit of the current dataset (or, for the demo, of the object it would photograph) with
+ *  `preset` costs: `{work, extra}` (extra: seconds photographing first, the demo's), or null. */
+function workOf(preset, demo) {
+  let budget;
+  // (The budget fields' changes, where they show this preset; asking for another would switch them.)
+  try { budget = shownPreset() === preset ? budgetOverrides(preset) : undefined; } catch { budget = undefined; }
+  const capture = demo ? wasm.demo_capture(preset, budget, Number($("demo-parts").value) || 1) : currentDataset?.capture();
+  if (!capture || capture === "null") return null;
+  return { work: JSON.parse(wasm.fit_work(preset, budget, capture)), extra: demo ? photographSeconds(JSON.parse(capture)) : 0 };
+}
+
+/** The preset line's time estimate; its seconds go to the line's data-estimate-s (settled joints)
+ *  and data-estimate-open-s (a joint left open), for tests. */
+function timeText(preset, demo) {
+  const about = $(demo ? "demo-preset-about" : "fit-preset-about");
+  delete about.dataset.estimateS;
+  delete about.dataset.estimateOpenS;
+  const d = document.body.dataset;
+  if (!d.adapter) return "";
+  let w;
+  try { w = workOf(preset, demo); } catch (e) { console.warn("no estimate:", errorText(e)); return ""; }
+  if (!w) return "Time: estimated once a capture is loaded.";
+  const e = estimate(d.adapter, d.software === "true", w.work, w.extra);
+  if (e) {
+    about.dataset.estimateS = e.settled.toFixed(1);
+    about.dataset.estimateOpenS = e.open.toFixed(1);
+  }
+  return estimateText(e, w.work.photometric_always);
+}
+
 function fillForms() {
   const d = catalogue.default ?? {};
   const cat = $("demo-category");
@@ -171,10 +201,10 @@ function fillForms() {
   for (const [select, about] of [[$("demo-preset"), $("demo-preset-about")], [$("fit-preset"), $("fit-preset-about")]]) {
     for (const p of catalogue.presets) option(select, p.name, p.name);
     select.value = preset;
+    const demo = select.id === "demo-preset";
     const describe = () => {
       const p = catalogue.presets.find((p) => p.name === select.value);
-      const d = document.body.dataset;
-      about.textContent = [p?.about ?? "", estimateText(d.adapter, d.software === "true", p?.budget)].filter(Boolean).join(". ");
+      about.textContent = [p?.about ?? "", timeText(select.value, demo)].filter(Boolean).join(". ");
     };
     describers.push(describe);
     select.addEventListener("change", describe);
@@ -191,7 +221,8 @@ function fillForms() {
     input.max = String(hi);
     input.value = String(Math.min(hi, Math.max(lo, parts ?? c?.default_parts ?? lo)));
   };
-  cat.addEventListener("change", () => setRange(null));
+  cat.addEventListener("change", () => { setRange(null); describePresets(); });
+  $("demo-parts").addEventListener("change", describePresets);
   setRange(d.parts);
   $("demo-seed").value = String(d.seed ?? 0);
 }
@@ -200,6 +231,7 @@ function setDataset(ds) {
   if (currentDataset && currentDataset !== ds) freeQuietly(currentDataset);
   currentDataset = ds;
   showDataset(ds);
+  describePresets();
   updateButtons();
 }
 
@@ -239,6 +271,7 @@ async function runDemo() {
   status.textContent = `Generating a ${category} with ${parts} movable part(s) and photographing both states…`;
   try {
     let ds;
+    const t0 = performance.now();
     try {
       ds = await wasm.Dataset.demo(category, parts, preset, seed, (p) => {
         if (!p || !(p.total > 0)) return;
@@ -252,6 +285,7 @@ async function runDemo() {
       return;
     }
     progress.value = 1;
+    document.body.dataset.photographS = ((performance.now() - t0) / 1000).toFixed(1);
     document.body.dataset.demo = "rendered";
     status.textContent = "Photographed; now fitting (see Fit).";
     setDataset(ds);
@@ -306,16 +340,14 @@ async function doFit(ds, preset, budget, what) {
     document.body.dataset.fit = "error";
     return;
   }
-  const t0 = performance.now();
-  const r = await runFit(wasm.fit, handle, preset, budget, what);
-  if (r) {
-    try {
-      recordFit(document.body.dataset.adapter, JSON.parse(wasm.preset_budget(preset, budget)).budget, (performance.now() - t0) / 1000);
-      describePresets();
-    } catch (e) {
-      console.warn("fit time not recorded:", e);
-    }
+  let eta = null;
+  try {
+    eta = new Eta(JSON.parse(wasm.fit_work(preset, budget, ds.capture())), document.body.dataset.adapter, performance.now() / 1000);
+  } catch (e) {
+    console.warn("no time estimate:", errorText(e));
   }
+  const r = await runFit(wasm.fit, handle, preset, budget, what, eta);
+  describePresets();
   if (!r) {
     $("result-empty").textContent = "No twin: the fit did not finish.";
     return;
@@ -366,7 +398,7 @@ async function main() {
     } catch (e) {
       throw new Error(`the wasm module (web/pkg) did not load: ${errorText(e)}; build it with web/build.sh`);
     }
-    const missing = ["adapter_report", "gpu_self_test", "catalogue", "preset_budget", "fit", "Dataset", "Viewer", "part_colours"].filter((n) => !wasm[n]);
+    const missing = ["adapter_report", "gpu_self_test", "catalogue", "preset_budget", "fit_work", "demo_capture", "fit", "Dataset", "Viewer", "part_colours"].filter((n) => !wasm[n]);
     if (missing.length) throw new Error(`web/pkg is out of date (missing ${missing.join(", ")}): rebuild it with web/build.sh`);
     await wasm.default();
     // The articulation's pictures are tinted with the viewer's part colours ("#rrggbb").

@@ -39,6 +39,9 @@ function summarise() {
   $("budget-summary").textContent = text;
 }
 
+/** The preset whose budget the fields show. */
+export const shownPreset = () => shown;
+
 /** Shows `name`'s budget in the fields the user has not changed. */
 export function showPresetBudget(name) {
   if (!presets.some((p) => p.name === name)) return;

@@ -14,6 +14,7 @@ const PHASES = {
   densify: "adding detail where the error is high",
   remesh: "rebuilding the triangles",
   recover: "optimising again after remeshing",
+  measure: "measuring the joints from the depth maps",
   candidates: "trying joint candidates",
   "bake-off": "comparing hinge and slide",
   refine: "refining the chosen joint",
@@ -32,7 +33,7 @@ const ARTICULATION_SERIES = [
 const TIMELINE = {
   initialise: "reconstruction", optimise: "reconstruction", densify: "reconstruction",
   remesh: "remeshing", recover: "remeshing",
-  candidates: "candidates", "bake-off": "bake-off", refine: "refinement",
+  measure: "measurement", candidates: "candidates", "bake-off": "bake-off", refine: "refinement",
 };
 const MAX_POINTS = 4000;
 
@@ -47,6 +48,8 @@ let points = {};
 let marks = [];             // where each stage began: {x: seconds into the fit, label, articulation}
 let timeline = {};          // seconds spent per timeline entry, and the one running
 let lastEntry = null, lastTime = 0;
+let eta = null;             // the running fit's Eta (estimate.js), or null
+let etaTimer = null;        // counts the ETA down between events
 
 function setFit(state) {
   document.body.dataset.fit = state;
@@ -88,6 +91,7 @@ function onEvent(ev) {
   if (ev.kind === "progress") {
     latest = ev;
     tick(ev);
+    eta?.event(ev, performance.now() / 1000);
     const loss = Number(ev.loss);
     const at = plotPoint(ev);
     if (at && ev.loss != null && loss > 0 && Number.isFinite(loss)) {
@@ -135,23 +139,38 @@ function text(id, value) {
   if (el.textContent !== value) el.textContent = value;
 }
 
+/** The time left, from the running fit's Eta (its seconds in `data-remaining-s`, for tests). */
+function showEta() {
+  if (!eta || !running) return;
+  const left = eta.remaining(performance.now() / 1000);
+  text("fit-eta", `about ${fmtDuration(left)}`);
+  $("fit-eta").dataset.remainingS = left.toFixed(1);
+  $("fit-eta").dataset.elapsedS = (performance.now() / 1000 - etaStart).toFixed(1);
+}
+let etaStart = 0;
+
+/** The fraction of the fit done, as the ETA sees it (elapsed over elapsed + left), or null. */
+function etaFraction() {
+  if (!eta || !running) return null;
+  const elapsed = performance.now() / 1000 - etaStart;
+  return elapsed / Math.max(1e-3, elapsed + eta.remaining(performance.now() / 1000));
+}
+
 function update() {
   if (!dirty) return;
   dirty = false;
   lastUpdate = performance.now();
+  showEta();
   const ev = latest;
   if (ev) {
     text("fit-stage", ev.stage ?? "—");
     text("fit-phase", ev.phase ? `${ev.phase} (${PHASES[ev.phase] ?? ev.phase})` : "—");
     text("fit-state", ev.state ?? "—");
     text("fit-iter", ev.iterations ? `${ev.iteration} / ${ev.iterations}` : String(ev.iteration ?? "—"));
-    text("fit-elapsed", fmtDuration(ev.elapsed_s));
-    let eta = ev.eta_s;
-    if (eta == null && ev.fraction > 0.02 && ev.elapsed_s > 0) eta = (ev.elapsed_s * (1 - ev.fraction)) / ev.fraction;
-    text("fit-eta", eta == null ? "—" : `about ${fmtDuration(eta)}`);
+    text("fit-elapsed", fmtDuration(running ? performance.now() / 1000 - etaStart : ev.elapsed_s));
     text("fit-faces", ev.faces != null ? Number(ev.faces).toLocaleString("en") : "—");
     text("fit-vertices", ev.vertices != null ? Number(ev.vertices).toLocaleString("en") : "—");
-    const fraction = Math.min(1, Math.max(0, Number(ev.fraction) || 0));
+    const fraction = Math.min(1, Math.max(0, etaFraction() ?? (Number(ev.fraction) || 0)));
     $("fit-progress").value = fraction;
     if (running && control === "run") {
       const loss = ev.loss != null ? `, loss ${Number(ev.loss).toPrecision(4)}` : "";
@@ -191,6 +210,8 @@ function resetPanel() {
   resetArticulation();
   for (const id of ["fit-stage", "fit-phase", "fit-state", "fit-iter", "fit-elapsed", "fit-eta", "fit-faces", "fit-vertices"]) text(id, "—");
   text("preview-caption", "");
+  delete $("fit-eta").dataset.remainingS;
+  delete $("fit-eta").dataset.elapsedS;
   $("fit-progress").value = 0;
   for (const c of [$("preview-render"), $("preview-target")]) { c.width = 1; c.height = 1; }
   delete document.body.dataset.preview;
@@ -235,11 +256,16 @@ function hintFor(message) {
 
 /**
  * Runs `fitFn(datasetHandle, preset, onEvent, control, budget)`; the handle is consumed. `budget`
- * is the budgets' overrides as JSON (undefined: the preset's own).
+ * is the budgets' overrides as JSON (undefined: the preset's own); `fitEta` (an Eta of
+ * estimate.js) says the time left, and learns this adapter's pace once the fit is done.
  * Resolves to the FitResult, or null when cancelled or failed (the panel says which).
  */
-export async function runFit(fitFn, datasetHandle, preset, budget, what) {
+export async function runFit(fitFn, datasetHandle, preset, budget, what, fitEta = null) {
   running = true;
+  eta = fitEta;
+  etaStart = performance.now() / 1000;
+  clearInterval(etaTimer);
+  etaTimer = setInterval(schedule, 1000); // the ETA and the bar move between events too
   control = "run";
   resetPanel();
   $("pause").textContent = "Pause";
@@ -256,10 +282,12 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what) {
     update();
     $("fit-progress").value = 1;
     const seconds = (performance.now() - t0) / 1000;
+    document.body.dataset.fitSeconds = seconds.toFixed(1);
     // The last progress event's elapsed time and estimate are stale once the fit returns: the
     // panel's elapsed time is the one "Done in" gives, and nothing remains.
     text("fit-elapsed", fmtDuration(seconds));
     text("fit-eta", "none (done)");
+    eta?.finish(document.body.dataset.adapter, performance.now() / 1000);
     show($("fit-status"), `Done in ${fmtDuration(seconds)}.`, "ok");
     drawTimeline();
     return result;
@@ -280,6 +308,8 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what) {
     return null;
   } finally {
     running = false;
+    eta = null;
+    clearInterval(etaTimer);
     $("pause").disabled = true;
     $("cancel").disabled = true;
     $("pause").textContent = "Pause";

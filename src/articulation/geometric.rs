@@ -432,27 +432,48 @@ const ANCHOR_POINTS: usize = 20_000;
 /// (part 0) and for a part with fewer than 3 points in either state. Each part's expected
 /// residual is its point noise over the static base's [`residual_floor`].
 pub fn measure_joints(clouds: &[ObservedState; 2]) -> Vec<Option<GeometricJoint>> {
-    let [s, e] = clouds;
-    let floor = s
-        .parts
-        .first()
-        .zip(e.parts.first())
-        .and_then(|(a, b)| residual_floor(a, b));
-    (0..s.parts.len().min(e.parts.len()))
-        .map(|part| {
-            if part == 0 {
-                return None;
-            }
-            let anchor = Anchor::new(
-                &s.others(part, ANCHOR_POINTS),
-                &e.others(part, ANCHOR_POINTS),
-            )
-            .built_along(&s.parts[0].normals);
-            let (a, b) = (&s.parts[part], &e.parts[part]);
-            let noise = floor.map(|f| f.hypot(point_noise(a.noise, b.noise)));
-            fit_joint(a, b, Some(&anchor), noise)
-        })
-        .collect()
+    let measurer = JointMeasurer::new(clouds);
+    (0..measurer.parts()).map(|p| measurer.measure(p)).collect()
+}
+
+/// [`measure_joints`] a part at a time, for a driver that reports (and yields) between parts:
+/// each part costs seconds.
+pub struct JointMeasurer<'a> {
+    clouds: &'a [ObservedState; 2],
+    floor: Option<f64>,
+}
+
+impl<'a> JointMeasurer<'a> {
+    pub fn new(clouds: &'a [ObservedState; 2]) -> Self {
+        let [s, e] = clouds;
+        let floor = s
+            .parts
+            .first()
+            .zip(e.parts.first())
+            .and_then(|(a, b)| residual_floor(a, b));
+        Self { clouds, floor }
+    }
+
+    /// Parts measured in both states, the base included.
+    pub fn parts(&self) -> usize {
+        self.clouds[0].parts.len().min(self.clouds[1].parts.len())
+    }
+
+    /// The joint of `part` (`None` for the base).
+    pub fn measure(&self, part: usize) -> Option<GeometricJoint> {
+        let [s, e] = self.clouds;
+        if part == 0 || part >= self.parts() {
+            return None;
+        }
+        let anchor = Anchor::new(
+            &s.others(part, ANCHOR_POINTS),
+            &e.others(part, ANCHOR_POINTS),
+        )
+        .built_along(&s.parts[0].normals);
+        let (a, b) = (&s.parts[part], &e.parts[part]);
+        let noise = self.floor.map(|f| f.hypot(point_noise(a.noise, b.noise)));
+        fit_joint(a, b, Some(&anchor), noise)
+    }
 }
 
 /// Points of a cloud moved rigidly (tests and fixtures).

@@ -64,6 +64,7 @@ impl FitConfig {
         let done = if event.is_articulation() {
             2.0 * per_state
                 + match event.phase {
+                    Phase::Measure => 0.0,
                     Phase::Candidates => f64::from(event.iteration),
                     Phase::BakeOff => f64::from(decide),
                     Phase::Refine => f64::from(decide) + f64::from(event.iteration) * refine_step,

@@ -19,6 +19,8 @@ pub enum Phase {
     Densify,
     Remesh,
     Recover,
+    /// Articulation: the joints measured from the depth and part maps, a part at a time.
+    Measure,
     /// Articulation: both joint-type candidates trained on alternating steps.
     Candidates,
     /// Articulation: the per-part joint-type decision.
@@ -31,13 +33,17 @@ pub enum Phase {
 impl Phase {
     /// Whether this is a stage of the articulation phase (both states at once).
     pub fn is_articulation(self) -> bool {
-        matches!(self, Phase::Candidates | Phase::BakeOff | Phase::Refine)
+        matches!(
+            self,
+            Phase::Measure | Phase::Candidates | Phase::BakeOff | Phase::Refine
+        )
     }
 
     /// The step of the method this phase belongs to, in the paper's words.
     pub fn stage(self) -> &'static str {
         match self {
             Phase::Remesh => "remeshing",
+            Phase::Measure => "joint measurement",
             Phase::Candidates | Phase::Refine => "articulation",
             Phase::BakeOff => "bake-off decision",
             _ => "reconstruction",
@@ -51,6 +57,7 @@ impl Phase {
             Phase::Densify => "densify",
             Phase::Remesh => "remesh",
             Phase::Recover => "recover",
+            Phase::Measure => "measure",
             Phase::Candidates => "candidates",
             Phase::BakeOff => "bake-off",
             Phase::Refine => "refine",

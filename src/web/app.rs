@@ -14,6 +14,7 @@ use crate::data::{
 use crate::export::{FitFolder, GLB_FILE, JOINTS_FILE, REPORT_FILE, ZIP_FILE};
 use crate::fit::object::FitConfig;
 use crate::fit::observer::{BakeOffView, Command, Marks, Observer, Preview, Progress};
+use crate::fit::work::Capture;
 use crate::gpu::now_seconds;
 use crate::pipeline::object::archive_stem;
 use crate::pipeline::preview::PREVIEW_FILE;
@@ -233,6 +234,12 @@ impl WebDataset {
         out
     }
 
+    /// Its capture (training views' size and count, movable parts) as JSON, for the time
+    /// estimates; `null` without training views.
+    pub fn capture(&self) -> String {
+        serde_json::to_string(&Capture::of(&self.0.dataset)).unwrap_or_default()
+    }
+
     /// Another handle to the same dataset (`fit` consumes the handle it is given).
     pub fn share(&self) -> WebDataset {
         WebDataset(self.0.clone())
@@ -259,7 +266,6 @@ impl Observer for PageObserver {
     fn progress(&mut self, e: &Progress) {
         let elapsed = now_seconds() - self.t0;
         let fraction = self.config.fraction_done(e);
-        let eta = (fraction > 0.02).then(|| elapsed * (1.0 - fraction) / fraction);
         let state = if e.is_articulation() {
             "both"
         } else {
@@ -279,7 +285,6 @@ impl Observer for PageObserver {
             ("faces", number(e.faces as u32)),
             ("elapsed_s", number(elapsed)),
             ("fraction", number(fraction)),
-            ("eta_s", opt(eta)),
             (
                 "candidate",
                 e.candidate.map_or(JsValue::NULL, |k| match k {

@@ -9,6 +9,7 @@ use wasm_bindgen::prelude::*;
 
 use crate::fit::object::FitConfig;
 use crate::fit::preset::{Budget, BudgetOverrides, Preset, UnknownPreset};
+use crate::fit::work::{Capture, FitWork};
 
 /// The page's budget overrides as JSON; a missing or `null` field keeps the preset's number.
 /// Unknown fields are refused so that a misspelt one is not silently ignored.
@@ -132,6 +133,41 @@ pub fn preset_budget(preset: String, overrides: Option<String>) -> Result<String
     let p = self::preset(&preset).map_err(super::js_error)?;
     let o = self::overrides(overrides.as_deref()).map_err(super::js_error)?;
     Ok(preset_entry(p, &o).to_string())
+}
+
+/// What a fit of `capture` (JSON of [`Capture`]) with `preset` and `overrides` will do: JSON of
+/// [`FitWork`], for the page's time estimates.
+#[wasm_bindgen]
+pub fn fit_work(
+    preset: String,
+    overrides: Option<String>,
+    capture: String,
+) -> Result<String, JsError> {
+    let config = fit_config(&preset, overrides.as_deref()).map_err(super::js_error)?;
+    let capture: Capture = serde_json::from_str(&capture)
+        .map_err(|e| JsError::new(&format!("fit work: capture: {e}")))?;
+    Ok(serde_json::to_string(&FitWork::of(&config, &capture)).unwrap_or_default())
+}
+
+/// The capture the page's demo takes of an object with `movable_parts` at `preset`: JSON of
+/// [`Capture`] (the demo photographs at never less than `fast`'s capture).
+#[wasm_bindgen]
+pub fn demo_capture(
+    preset: String,
+    overrides: Option<String>,
+    movable_parts: u32,
+) -> Result<String, JsError> {
+    let config = fit_config(&preset, overrides.as_deref()).map_err(super::js_error)?;
+    let spec = config.full_demo_capture(0);
+    let capture = Capture {
+        width: spec.width,
+        height: spec.height,
+        views: spec.train_views,
+        movable_parts: movable_parts as usize,
+        depth: true,
+        part_pixels: Vec::new(),
+    };
+    Ok(serde_json::to_string(&capture).unwrap_or_default())
 }
 
 #[cfg(test)]

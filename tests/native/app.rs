@@ -132,11 +132,20 @@ fn a_heard_fit_reports_every_stage_in_order_and_its_folder_holds_the_downloads()
     for stage in [
         "reconstruction",
         "remeshing",
+        "joint measurement",
         "articulation",
         "bake-off decision",
     ] {
         assert!(stages.contains(&stage), "{stage} missing from {stages:?}");
     }
+    // The measurement reports before and after each movable part (the lid): seconds of CPU each.
+    let measured: Vec<(u32, u32)> = recorder
+        .events
+        .iter()
+        .filter(|e| e.phase == Phase::Measure)
+        .map(|e| (e.iteration, e.iterations))
+        .collect();
+    assert_eq!(measured, [(0, 1), (1, 1)]);
     let last = recorder.events.last().unwrap();
     assert_eq!((last.phase, last.state), (Phase::Done, State::End));
     assert!(

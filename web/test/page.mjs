@@ -25,6 +25,7 @@ import {
 } from "./result.mjs";
 import { changed, snapshot } from "./canvas.mjs";
 import { checkMobileAndTouch } from "./touch.mjs";
+import { checkTimes, readEstimate, sampleEta } from "./timing.mjs";
 
 // The parity fit's preset: tiny in CI; ARTMESH_PARITY_PRESET=fast (64 px, 12 views; ~25–32 min in
 // the browser) asserts the issue's 0.5° / 5 mm (docs/results.md, "Browser vs native").
@@ -135,7 +136,7 @@ try {
       const presets = [await page.inputValue("#demo-preset"), await page.inputValue("#fit-preset")];
       check(presets.every((p) => p === "tiny"), `a software adapter starts at the tiny preset (${presets.join(", ")})`);
       const about = await page.locator("#demo-preset-about").textContent();
-      check(/Estimated fit time: about \d+ s/.test(about), `the time a tiny fit takes is shown before it starts: ${about}`);
+      check(/Estimated time: about \d+ s/.test(about), `the time a tiny fit takes is shown before it starts: ${about}`);
     }
     await page.click("#selftest-run");
     await page.waitForFunction(() => ["pass", "fail"].includes(document.body.dataset.selftest) ||
@@ -319,8 +320,10 @@ try {
     await page.selectOption("#demo-preset", demoPreset);
     await page.fill("#demo-seed", "0");
     await clearFlags("result", "fit", "preview", "demo", "moved", "bakeOffs");
+    const estimate = await readEstimate(page, true);
     const t0 = performance.now();
     await page.click("#demo-run");
+    const stopEta = sampleEta(page);
     await midFit();
     await page.waitForFunction(() => {
       const d = document.body.dataset;
@@ -333,6 +336,7 @@ try {
     console.log(`browser demo (${demoPreset}): ${browserS.toFixed(1)} s`);
     console.log(`demo timing: native ${nativeS.toFixed(1)} s, browser ${browserS.toFixed(1)} s` +
       ` (${category}, 2 parts, seed 0, ${demoPreset}; native laptop 1 part: ${nativeLaptopS?.toFixed(1) ?? "—"} s)`);
+    await checkTimes({ page, check, name: `the ${demoPreset} demo`, estimate, samples: await stopEta() });
     await checkDemoScore({ page, check, preset: demoPreset });
     const visible = await page.locator("#metrics").isVisible();
     const rows = await page.locator("#metrics tbody tr").count();

@@ -4,10 +4,11 @@
 //! skip them.
 
 use super::config::{ArticulationConfig, GeometryUse};
-use crate::articulation::geometric::{GeometricJoint, measure_joints};
+use crate::articulation::geometric::{GeometricJoint, JointMeasurer};
 use crate::articulation::observed::{CloudOptions, ObservedState, observe_dataset};
 use crate::data::{Dataset, Split, State};
-use crate::gpu::{GpuError, GpuResult};
+use crate::fit::observer::{Observer, Phase, Progress, checkpoint};
+use crate::gpu::{GpuError, GpuResult, now_seconds};
 
 /// What the training views measure.
 pub(super) struct Measured {
@@ -24,13 +25,17 @@ pub(super) struct Measured {
 /// to `warnings`.
 /// `sampled`: both states' training clouds if the reconstruction already sampled them, with the
 /// options it sampled them with (reused when those are `config`'s).
-pub(super) fn measure(
+/// `observer` hears a [`Phase::Measure`] event before each movable part (and may pause or cancel
+/// there): a part's measurement takes seconds, and in the browser the page turns between them.
+pub(super) async fn measure(
     dataset: &Dataset,
     config: &ArticulationConfig,
     k: usize,
     sampled: Option<&(CloudOptions, [ObservedState; 2])>,
     warnings: &mut Vec<String>,
+    observer: &mut dyn Observer,
 ) -> GpuResult<Measured> {
+    let t0 = now_seconds();
     let train_clouds = match sampled {
         Some((options, clouds))
             if *options == config.clouds && config.geometry != GeometryUse::Off =>
@@ -42,7 +47,7 @@ pub(super) fn measure(
     if let Some(clouds) = &train_clouds {
         measurement_warnings(clouds, warnings)?;
     }
-    let joints = measure_joints_of(k, train_clouds.as_ref());
+    let joints = measure_joints_of(k, train_clouds.as_ref(), observer, t0).await?;
     let settled: Vec<bool> = joints
         .iter()
         .map(|g| config.geometry == GeometryUse::Settle && g.is_some_and(|g| g.settled()))
@@ -121,11 +126,43 @@ pub(super) fn observe(
 }
 
 /// The joints the training views' depth and part maps measure, one per part (`None` for the
-/// base and for a part not measured in both states).
-fn measure_joints_of(k: usize, train: Option<&[ObservedState; 2]>) -> Vec<Option<GeometricJoint>> {
-    let mut joints = train.map(measure_joints).unwrap_or_default();
+/// base and for a part not measured in both states), a [`Phase::Measure`] event before each.
+async fn measure_joints_of(
+    k: usize,
+    train: Option<&[ObservedState; 2]>,
+    observer: &mut dyn Observer,
+    t0: f64,
+) -> GpuResult<Vec<Option<GeometricJoint>>> {
+    let mut joints = Vec::with_capacity(k);
+    if let Some(clouds) = train {
+        let measurer = JointMeasurer::new(clouds);
+        let movable = measurer.parts().saturating_sub(1) as u32;
+        for part in 0..measurer.parts() {
+            if part > 0 {
+                checkpoint(observer, &measuring(part as u32 - 1, movable, t0)).await?;
+            }
+            joints.push(measurer.measure(part));
+        }
+        checkpoint(observer, &measuring(movable, movable, t0)).await?;
+    }
     joints.resize(k, None);
-    joints
+    Ok(joints)
+}
+
+/// The event of the joint measurement with `done` of `parts` movable parts measured.
+fn measuring(done: u32, parts: u32, t0: f64) -> Progress {
+    Progress {
+        state: State::End,
+        phase: Phase::Measure,
+        iteration: done,
+        iterations: parts,
+        loss: None,
+        psnr: None,
+        vertices: 0,
+        faces: 0,
+        elapsed_s: now_seconds() - t0,
+        candidate: None,
+    }
 }
 
 /// What a user should know about the measurements: views without depth or part maps. A movable

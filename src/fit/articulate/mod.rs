@@ -112,7 +112,8 @@ pub async fn articulate(
 
     // Seeds: the reconstructions', then the measured joints where there are.
     let seeds = reconstruction_seeds(s1, s2, k);
-    let measured = measure(dataset, config, k, rec.train_clouds.as_ref(), &mut warnings)?;
+    let sampled = rec.train_clouds.as_ref();
+    let measured = measure(dataset, config, k, sampled, &mut warnings, observer).await?;
     let mut candidates = Candidates::seeded(seeds, &measured);
     unsettled_warning(&measured, &candidates.trainable, &mut warnings);
     surface_warnings(s1, &candidates.seeds, &measured, &mut warnings);

@@ -147,6 +147,9 @@ pub(super) async fn refine(
                 }
             }
             last_objective = Some(objective);
+        } else {
+            // Every step is a checkpoint: a step takes seconds on a software adapter.
+            checkpoint(observer, &run.event(Phase::Refine, step + 1, refine, None)).await?;
         }
     }
     Ok((refine_stopped_at, now_seconds() - t_refine))
