@@ -85,6 +85,9 @@ pub struct Progress {
     /// In the candidates stage, whose step this was: the hinge and the slide candidates train
     /// on alternate steps, so their losses are two curves, not one.
     pub candidate: Option<JointKind>,
+    /// In the joint measurement: the movable parts measured so far whose joints the depth maps
+    /// left open (not measured, or not settled); the photometric stages will decide them.
+    pub open: u32,
 }
 
 impl Progress {

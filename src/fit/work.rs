@@ -186,7 +186,8 @@ mod tests {
             let train = State::ALL.map(|s| dataset.views(s, Split::Train).unwrap());
             let frames = train.iter().flat_map(|v| &v.frames);
             let maps = frames.map(|f| f.parts.as_ref().unwrap());
-            maps.map(|m| m.ids.iter().filter(|&&id| id == part).count() as u64).sum()
+            maps.map(|m| m.ids.iter().filter(|&&id| id == part).count() as u64)
+                .sum()
         };
         assert_eq!(capture.part_pixels, [labelled(1), labelled(2)]);
         assert!(capture.part_pixels.iter().all(|&n| n > 0));

@@ -285,6 +285,7 @@ impl Observer for PageObserver {
             ("faces", number(e.faces as u32)),
             ("elapsed_s", number(elapsed)),
             ("fraction", number(fraction)),
+            ("open", number(e.open)),
             (
                 "candidate",
                 e.candidate.map_or(JsValue::NULL, |k| match k {

@@ -137,25 +137,36 @@ async fn measure_joints_of(
     if let Some(clouds) = train {
         let measurer = JointMeasurer::new(clouds);
         let movable = measurer.parts().saturating_sub(1) as u32;
+        // Open so far: measured movable parts without a settled joint.
+        let open = |joints: &[Option<GeometricJoint>]| -> u32 {
+            let unsettled = joints
+                .iter()
+                .skip(1)
+                .filter(|g| !g.is_some_and(|g| g.settled()));
+            unsettled.count() as u32
+        };
         for part in 0..measurer.parts() {
             if part > 0 {
-                checkpoint(observer, &measuring(part as u32 - 1, movable, t0)).await?;
+                let at = measuring((part as u32 - 1, movable), open(&joints), t0);
+                checkpoint(observer, &at).await?;
             }
             joints.push(measurer.measure(part));
         }
-        checkpoint(observer, &measuring(movable, movable, t0)).await?;
+        checkpoint(observer, &measuring((movable, movable), open(&joints), t0)).await?;
     }
     joints.resize(k, None);
     Ok(joints)
 }
 
-/// The event of the joint measurement with `done` of `parts` movable parts measured.
-fn measuring(done: u32, parts: u32, t0: f64) -> Progress {
+/// The event of the joint measurement with `done` of `parts` movable parts measured, `open` of
+/// them left open.
+fn measuring((done, parts): (u32, u32), open: u32, t0: f64) -> Progress {
     Progress {
         state: State::End,
         phase: Phase::Measure,
         iteration: done,
         iterations: parts,
+        open,
         loss: None,
         psnr: None,
         vertices: 0,

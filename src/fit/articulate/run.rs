@@ -78,6 +78,7 @@ impl Run<'_> {
             faces: self.sizes.1,
             elapsed_s: now_seconds() - self.t0,
             candidate: None,
+            open: 0,
         }
     }
 }

@@ -59,6 +59,7 @@ impl StateRun<'_> {
             faces: sizes.1,
             elapsed_s: now_seconds() - self.t0,
             candidate: None,
+            open: 0,
         }
     }
 
