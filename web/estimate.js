@@ -9,7 +9,8 @@
 // and each kind of CPU work) ran from these rates, and later estimates there use it (localStorage).
 const SOFTWARE = {
   warmup: 9,                 // s, once: pipelines compile (start state's 32² optimise 13–16 s, end's 4–6 s)
-  surface: [0.008, 7.3e-5],  // per surface step (tiny: 60 steps in 4–6 s at 32²)
+  surface: [0.054, 2.8e-5],  // per surface step (60 in 4–6 s at 32²; at 64², a fast state whose depth
+                             // could not measure a part: 150 in 21–26 s)
   remesh: [0.4, 4.7e-5],     // per state, remeshed mesh to first recovery step: its PSNR, per pixel × view (0.4 s tiny, 2.7 s fast)
   recover: [0.03, 7.3e-5],   // per recovery step (0.105 s at 32², 0.33 s at 64² with 20× the faces)
   evaluate: [0.25, 6e-5],    // per state: PSNR renders, per working pixel × view (0.5 s tiny, 3.2 s fast)
@@ -151,16 +152,20 @@ export class Eta {
     } else if (ev.phase === "candidates" && ev.iterations === 0 && open && !this.work.photometric_always) {
       // None of the open joints had a surface to train: no image steps after all.
       this.replan(this.work, false);
-    } else if (key?.endsWith(".surface") && ev.iterations > 0 && this.work.surface_steps === 0) {
-      // The depth could not measure every part's surface, so the state optimises its surfaces,
-      // and that part's joint is left to the image stages.
-      this.replan({ ...this.work, surface_steps: ev.iterations }, true);
     }
     let j = this.stages.findIndex((s) => s.key === key);
     // "candidates" with no steps: the joints were measured, the bake-off comes next.
     if (j < 0 && ev.state === "both") j = this.stages.findIndex((s) => s.key === "bakeoff");
     if (j < 0) return;
     this.advance(j, now);
+    if (key.endsWith(".surface") && ev.iterations > 0 && this.work.surface_steps === 0 && !this.stages[j].steps) {
+      // The depth could not measure every part's surface, so this state optimises its surfaces
+      // (the other may not), and that part's joint is left to the image stages.
+      if (!this.stages.some((s) => s.key === "candidates")) this.replan(this.work, true);
+      const stage = this.stages[j];
+      stage.steps = ev.iterations;
+      stage.s = stage.fixed + ev.iterations * step(SOFTWARE.surface, this.work.working_pixels) * this.scales.gpu;
+    }
     if (ev.iterations > 0) {
       // The refinement may stop at its next check: that is the end to aim at, not its last step.
       const every = this.work.refine_check_every, least = this.work.refine_min_steps;
