@@ -66,7 +66,12 @@ function storedScales(adapter) {
   try { return JSON.parse(localStorage.getItem(KEY + adapter) ?? "null"); } catch { return null; }
 }
 
-const total = (stages, scales) => stages.reduce((t, s) => t + s.s * (scales?.[s.cls] ?? 1), 0);
+/** `plan(work, open)` at an adapter's pace: each stage (and its warm-up) times its class's ratio. */
+function scaledPlan(work, open, scales) {
+  return plan(work, open).map((s) => ({ ...s, s: s.s * (scales?.[s.cls] ?? 1), fixed: s.fixed * (scales?.[s.cls] ?? 1) }));
+}
+
+const total = (stages) => stages.reduce((t, s) => t + s.s, 0);
 
 /** Seconds a fit of `work` takes on `adapter`: `{settled, open, own}` (settled: the depth maps
  *  settle every joint; open: they leave one to the photometric stages; own: from this adapter's
@@ -76,7 +81,7 @@ export function estimate(adapter, software, work, extra = 0) {
   const own = storedScales(adapter);
   if (!own && !software) return null;
   const before = extra * (own?.gpu ?? 1);
-  return { settled: before + total(plan(work, false), own), open: before + total(plan(work, true), own), own: !!own };
+  return { settled: before + total(scaledPlan(work, false, own)), open: before + total(scaledPlan(work, true, own)), own: !!own };
 }
 
 function fmt(s) {
@@ -101,12 +106,18 @@ export class Eta {
   constructor(work, adapter, now) {
     this.work = work;
     this.scales = { ...Object.fromEntries(CLASSES.map((c) => [c, 1])), ...storedScales(adapter) };
-    this.stages = plan(work, false).map((s) => ({ ...s, s: s.s * this.scales[s.cls], fixed: s.fixed * this.scales[s.cls] }));
+    this.stages = scaledPlan(work, false, this.scales);
     this.i = 0;
     this.start = now;
     this.f = 0;
     this.fAt = now;
     this.f0At = null;
+    this.stretch = 1;
+  }
+
+  /** What each stage was predicted to take and took (s), once finished: "key:predicted/took,…". */
+  summary() {
+    return this.stages.map((s) => `${s.key}:${s.s.toFixed(1)}/${(s.actual ?? 0).toFixed(1)}`).join(",");
   }
 
   /** The stage a progress event belongs to (null: none of the plan's). The articulation's closing
@@ -139,7 +150,7 @@ export class Eta {
   /** Plans the stages from the running one on anew, for `work`, with the image stages or not. */
   replan(work, open) {
     this.work = work;
-    const rest = plan(work, open).slice(this.i).map((s) => ({ ...s, s: s.s * this.scales[s.cls], fixed: s.fixed * this.scales[s.cls] }));
+    const rest = scaledPlan(work, open, this.scales).slice(this.i);
     this.stages = [...this.stages.slice(0, this.i), ...rest];
   }
 
@@ -196,7 +207,7 @@ export class Eta {
     if (this.i >= this.stages.length) return 0;
     const k = Object.fromEntries(CLASSES.map((c) => [c, this.scale(c)]));
     const cur = this.stages[this.i];
-    const expected = cur.s * k[cur.cls] * (this.stretch ?? 1);
+    const expected = cur.s * k[cur.cls] * this.stretch;
     // Its prediction counted down, and its own pace so far, weighed by how much of it is done
     // (a stage's first steps, or its first part of a few, say little of the rest).
     const scale = expected / Math.max(cur.s, 1e-9), fixed = cur.fixed * scale;
@@ -217,8 +228,6 @@ export class Eta {
       const predicted = done.reduce((t, s) => t + s.s / this.scales[cls], 0);
       return predicted > 0 ? done.reduce((t, s) => t + s.actual, 0) / predicted : 1;
     };
-    // What each stage was predicted to take and took, for tests and the curious.
-    document.body.dataset.etaStages = this.stages.map((s) => `${s.key}:${s.s.toFixed(1)}/${s.actual.toFixed(1)}`).join(",");
     if (!adapter) return;
     try { localStorage.setItem(KEY + adapter, JSON.stringify(Object.fromEntries(CLASSES.map((c) => [c, ratio(c)])))); } catch { /* storage off */ }
   }

@@ -287,7 +287,11 @@ export async function runFit(fitFn, datasetHandle, preset, budget, what, fitEta 
     // panel's elapsed time is the one "Done in" gives, and nothing remains.
     text("fit-elapsed", fmtDuration(seconds));
     text("fit-eta", "none (done)");
-    eta?.finish(document.body.dataset.adapter, performance.now() / 1000);
+    if (eta) {
+      eta.finish(document.body.dataset.adapter, performance.now() / 1000);
+      // What each stage was predicted to take and took, for tests and the curious.
+      document.body.dataset.etaStages = eta.summary();
+    }
     show($("fit-status"), `Done in ${fmtDuration(seconds)}.`, "ok");
     drawTimeline();
     return result;
